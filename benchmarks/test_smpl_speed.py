@@ -1,0 +1,82 @@
+"""Speed of SMPL training and control on this machine's CPU.
+
+Run with `pytest benchmarks --benchmark-only`. Training is measured on paper-sized data: 9,800
+training windows (70 % of 14,000 babbling samples) and 1,400 validation windows, batch 32,
+sequence length 15, closed loop through a 2 x 64 LSTM forward model. The column count is the Exp1S
+stage: column 5 also runs the four frozen columns before it.
+"""
+
+from collections.abc import Iterator
+
+import pytest
+import torch
+
+from smpl.forward_model import ForwardModel
+from smpl.progressive import ProgressiveLSTM
+from smpl.training import (
+    CPU_THREADS,
+    InverseTrainingConfig,
+    limited_cpu_threads,
+    train_inverse_model,
+)
+from smpl.windows import SEQUENCE_LENGTH, BabblingWindows, inverse_input_size
+
+POSE_SIZE = 6
+TRAIN_WINDOWS = 9_800
+VALIDATION_WINDOWS = 1_400
+CPU = torch.device("cpu")
+
+
+@pytest.fixture(autouse=True)
+def _training_thread_count() -> Iterator[None]:
+    with limited_cpu_threads(CPU_THREADS, CPU):
+        yield
+
+
+def _exp1s_network(columns: int) -> ProgressiveLSTM:
+    torch.manual_seed(0)
+    network = ProgressiveLSTM()
+    for modules in range(1, columns + 1):
+        network.add_column(inverse_input_size(POSE_SIZE, 2 * modules), 2 * modules)
+    return network
+
+
+def _random_windows(count: int, action_size: int, seed: int) -> BabblingWindows:
+    generator = torch.Generator().manual_seed(seed)
+    return BabblingWindows(
+        torch.rand(count, SEQUENCE_LENGTH + 2, POSE_SIZE, generator=generator) * 2 - 1,
+        torch.rand(count, SEQUENCE_LENGTH, action_size, generator=generator) * 2 - 1,
+        torch.zeros(count, SEQUENCE_LENGTH, 0),
+    )
+
+
+@pytest.mark.parametrize("columns", [1, 5])
+def test_closed_loop_training_epoch(benchmark, columns: int) -> None:
+    network = _exp1s_network(columns)
+    action_size = network.action_size
+    forward_model = ForwardModel(action_size).freeze()
+    train = _random_windows(TRAIN_WINDOWS, action_size, seed=1)
+    validation = _random_windows(VALIDATION_WINDOWS, action_size, seed=2)
+    config = InverseTrainingConfig(max_epochs=1)
+
+    benchmark.pedantic(
+        lambda: train_inverse_model(network, forward_model, train, validation, config, CPU),
+        rounds=3,
+        iterations=1,
+        warmup_rounds=0,
+    )
+    benchmark.extra_info["train_windows_per_second"] = TRAIN_WINDOWS / benchmark.stats.stats.mean
+
+
+@pytest.mark.parametrize("columns", [1, 5])
+def test_single_step_inference_latency(benchmark, columns: int) -> None:
+    network = _exp1s_network(columns).eval()
+    inputs = torch.rand(1, network.input_size) * 2 - 1
+    state = network.initial_state(batch_size=1)
+
+    def control_step() -> torch.Tensor:
+        with torch.no_grad():
+            return network.step(inputs, state).action
+
+    action = benchmark(control_step)
+    assert action.shape == (1, network.action_size)

@@ -1,0 +1,76 @@
+"""A synthetic arm with known smooth dynamics, so learners can be tested without MuJoCo."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+
+import pytest
+import torch
+
+from smpl.forward_model import ForwardModel
+from smpl.training import (
+    CPU_THREADS,
+    ForwardTrainingConfig,
+    limited_cpu_threads,
+    train_forward_model,
+)
+from smpl.windows import BabblingWindows
+
+POSE_SIZE = 6
+LAG = 0.5
+"""Fraction of the previous pose the synthetic arm keeps each step (first-order lag)."""
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _few_cpu_threads() -> Iterator[None]:
+    """Runs these tiny models on the thread count training uses (see smpl.training.CPU_THREADS)."""
+    with limited_cpu_threads(CPU_THREADS, torch.device("cpu")):
+        yield
+
+
+def synthetic_windows(
+    recording_steps: int, action_size: int, seed: int, arm_seed: int = 0
+) -> BabblingWindows:
+    """Windows of random babbling on an arm with x_{s+1} = LAG x_s + (1 - LAG) tanh(a_s M).
+
+    `arm_seed` picks the arm (the fixed matrix M), `seed` the babbling actions.
+    """
+    arm = torch.Generator().manual_seed(arm_seed)
+    mixing = torch.randn(action_size, POSE_SIZE, generator=arm)
+    babbling = torch.Generator().manual_seed(seed)
+    actions = torch.rand(recording_steps, action_size, generator=babbling) * 2 - 1
+    poses = torch.zeros(recording_steps, POSE_SIZE)
+    for step in range(1, recording_steps):
+        steady_pose = torch.tanh(actions[step - 1] @ mixing)
+        poses[step] = LAG * poses[step - 1] + (1 - LAG) * steady_pose
+    return BabblingWindows.from_recording(poses, actions)
+
+
+@pytest.fixture(scope="session")
+def make_arm_windows() -> Callable[..., BabblingWindows]:
+    """`synthetic_windows`, for tests that build arms of their own."""
+    return synthetic_windows
+
+
+@pytest.fixture(scope="session")
+def arm_data() -> dict[str, BabblingWindows]:
+    """Training and validation windows of one two-input synthetic arm, from separate recordings."""
+    return {
+        "train": synthetic_windows(400, action_size=2, seed=1),
+        "validation": synthetic_windows(150, action_size=2, seed=2),
+    }
+
+
+@pytest.fixture(scope="session")
+def trained_forward_model(arm_data: dict[str, BabblingWindows]) -> ForwardModel:
+    """A frozen forward model of the synthetic arm (shared; never modify it in a test)."""
+    torch.manual_seed(0)
+    forward_model = ForwardModel(actuation_size=2)
+    train_forward_model(
+        forward_model,
+        arm_data["train"],
+        arm_data["validation"],
+        ForwardTrainingConfig(max_epochs=60, batch_size=32),
+        device=torch.device("cpu"),
+    )
+    return forward_model

@@ -1,0 +1,220 @@
+import dataclasses
+import io
+
+import pytest
+import torch
+from rich.console import Console
+
+from smpl.baselines import VAELSTMInverse
+from smpl.forward_model import ForwardModel
+from smpl.progress import EpochProgressBar
+from smpl.progressive import ProgressiveLSTM
+from smpl.training import (
+    EarlyStopping,
+    ForwardTrainingConfig,
+    InverseTrainingConfig,
+    evaluate_loss,
+    fit,
+    forward_model_loss,
+    inverse_model_loss,
+    train_inverse_model,
+)
+from smpl.windows import BabblingWindows, inverse_input_size
+
+CPU = torch.device("cpu")
+SHORT_RUN = InverseTrainingConfig(max_epochs=3, patience=3)
+
+
+def _fresh_column(seed: int = 0) -> ProgressiveLSTM:
+    torch.manual_seed(seed)
+    network = ProgressiveLSTM()
+    network.add_column(inverse_input_size(6, 2), 2)
+    return network
+
+
+def _state(model: torch.nn.Module) -> dict[str, torch.Tensor]:
+    return {name: value.clone() for name, value in model.state_dict().items()}
+
+
+@pytest.mark.parametrize("feed_back_error", [True, False])
+def test_inverse_model_learns_the_synthetic_arm_in_the_loop(
+    arm_data: dict[str, BabblingWindows], trained_forward_model: ForwardModel, feed_back_error: bool
+) -> None:
+    network = _fresh_column()
+    config = InverseTrainingConfig(max_epochs=12, feed_back_error=feed_back_error)
+
+    def validation_loss() -> float:
+        return evaluate_loss(
+            network,
+            lambda windows: inverse_model_loss(
+                network, trained_forward_model, windows, feed_back_error
+            ),
+            arm_data["validation"],
+        )
+
+    untrained_loss = validation_loss()
+    result = train_inverse_model(
+        network, trained_forward_model, arm_data["train"], arm_data["validation"], config, CPU
+    )
+    assert result.best_validation_loss < untrained_loss / 5
+    assert validation_loss() == result.best_validation_loss  # the best weights are the ones kept
+
+
+def test_inverse_training_leaves_the_forward_model_untouched(
+    arm_data: dict[str, BabblingWindows], trained_forward_model: ForwardModel
+) -> None:
+    before = _state(trained_forward_model)
+    train_inverse_model(
+        _fresh_column(),
+        trained_forward_model,
+        arm_data["train"],
+        arm_data["validation"],
+        SHORT_RUN,
+        CPU,
+    )
+    assert all(
+        torch.equal(value, before[name])
+        for name, value in trained_forward_model.state_dict().items()
+    )
+
+
+def test_pose_term_changes_the_objective(
+    arm_data: dict[str, BabblingWindows], trained_forward_model: ForwardModel
+) -> None:
+    network, windows = _fresh_column(), arm_data["validation"]
+    with torch.no_grad():
+        actions_only = inverse_model_loss(network, trained_forward_model, windows)
+        with_poses = inverse_model_loss(
+            network, trained_forward_model, windows, pose_loss_weight=1.0
+        )
+    assert with_poses > actions_only
+
+
+@pytest.mark.parametrize(
+    "make_model", [_fresh_column, lambda: VAELSTMInverse(14, 2, hidden_size=16)]
+)
+def test_same_seed_gives_identical_weights_and_another_seed_does_not(
+    arm_data: dict[str, BabblingWindows], trained_forward_model: ForwardModel, make_model
+) -> None:
+    def train(seed: int) -> dict[str, torch.Tensor]:
+        torch.manual_seed(0)
+        model = make_model()
+        config = dataclasses.replace(SHORT_RUN, seed=seed)
+        train_inverse_model(
+            model, trained_forward_model, arm_data["train"], arm_data["validation"], config, CPU
+        )
+        return _state(model)
+
+    first, again, other = train(seed=1), train(seed=1), train(seed=2)
+    assert all(torch.equal(first[name], again[name]) for name in first)
+    assert not all(torch.equal(first[name], other[name]) for name in first)
+
+
+def test_training_restores_the_callers_random_state_and_thread_count(
+    arm_data: dict[str, BabblingWindows], trained_forward_model: ForwardModel
+) -> None:
+    network = _fresh_column()
+    previous_threads = torch.get_num_threads()
+    torch.set_num_threads(2)
+    torch.manual_seed(123)
+    expected_draw = torch.rand(3)
+    torch.manual_seed(123)
+    try:
+        train_inverse_model(
+            network,
+            trained_forward_model,
+            arm_data["train"],
+            arm_data["validation"],
+            SHORT_RUN,
+            CPU,
+        )
+        assert torch.get_num_threads() == 2
+    finally:
+        torch.set_num_threads(previous_threads)
+    assert torch.equal(torch.rand(3), expected_draw)
+
+
+def test_every_epoch_is_reported_and_training_stops_after_patience_without_improvement(
+    arm_data: dict[str, BabblingWindows],
+) -> None:
+    torch.manual_seed(0)
+    forward_model = ForwardModel(actuation_size=2, hidden_size=8)
+    reports = []
+    # A learning rate this large makes the validation loss stop improving almost at once.
+    config = ForwardTrainingConfig(max_epochs=40, patience=2, learning_rate=5.0)
+    result = fit(
+        forward_model,
+        lambda windows: forward_model_loss(forward_model, windows),
+        arm_data["train"],
+        arm_data["validation"],
+        config,
+        CPU,
+        reports.append,
+    )
+    assert result.stopped_early and result.epochs_run < 40
+    assert reports == result.history and len(reports) == result.epochs_run
+    assert result.epochs_run - 1 - result.best_epoch == config.patience
+    assert min(report.validation_loss for report in reports) == result.best_validation_loss
+
+
+def test_early_stopping_counts_epochs_since_the_best_loss() -> None:
+    stopping = EarlyStopping(patience=2)
+    decisions = []
+    for epoch, loss in enumerate([3.0, 2.0, 2.5, 1.5, 1.7, 1.6]):
+        improved = stopping.update(epoch, loss)
+        decisions.append((improved, stopping.should_stop))
+    assert decisions == [
+        (True, False),
+        (True, False),
+        (False, False),
+        (True, False),
+        (False, False),
+        (False, True),
+    ]
+    assert (stopping.best_epoch, stopping.best_loss) == (3, 1.5)
+
+
+def test_a_model_without_trainable_weights_is_refused(arm_data: dict[str, BabblingWindows]) -> None:
+    frozen = ForwardModel(actuation_size=2, hidden_size=8).freeze()
+    with pytest.raises(ValueError, match="no trainable parameters"):
+        fit(
+            frozen,
+            lambda windows: forward_model_loss(frozen, windows),
+            arm_data["train"],
+            arm_data["validation"],
+            SHORT_RUN,
+            CPU,
+        )
+
+
+def test_inverse_training_needs_a_frozen_forward_model(
+    arm_data: dict[str, BabblingWindows],
+) -> None:
+    with pytest.raises(ValueError, match="frozen"):
+        train_inverse_model(
+            _fresh_column(),
+            ForwardModel(actuation_size=2),
+            arm_data["train"],
+            arm_data["validation"],
+            SHORT_RUN,
+            CPU,
+        )
+
+
+def test_progress_bar_shows_epochs_done_and_the_latest_losses(
+    arm_data: dict[str, BabblingWindows], trained_forward_model: ForwardModel
+) -> None:
+    output = io.StringIO()
+    with EpochProgressBar("column 1", SHORT_RUN.max_epochs, Console(file=output, width=150)) as bar:
+        result = train_inverse_model(
+            _fresh_column(),
+            trained_forward_model,
+            arm_data["train"],
+            arm_data["validation"],
+            SHORT_RUN,
+            CPU,
+            on_epoch_end=bar,
+        )
+    shown = output.getvalue()
+    assert "column 1" in shown and f"{result.epochs_run}/{SHORT_RUN.max_epochs}" in shown
+    assert f"best {result.best_validation_loss:.2e}" in shown
