@@ -1,0 +1,132 @@
+"""What every softbench robot shares: a frozen spec that builds its MJCF, and its action map.
+
+A robot's action is a vector in [-1, 1]; each MuJoCo actuator's control is a piecewise-linear
+function of one action entry, given by its values at -1, 0 and +1. The map is written into the
+MJCF as ``<custom><numeric name="action_map">`` so that an exported model file is enough to drive
+the robot (``softbench.robots.physics.SoftArmPhysics`` reads it back).
+"""
+
+import abc
+import dataclasses
+import math
+
+import mujoco
+import numpy as np
+
+ACTION_MAP_NAME = "action_map"
+GRAVITY = 9.81  # (m/s²)
+
+
+@dataclasses.dataclass(frozen=True)
+class ActuatorMap:
+  """Control of one actuator as a function of action entry ``action_index``.
+
+  ``ctrl = interp(a, [-1, 0, 1], [at_minus_one, at_zero, at_plus_one])``.
+  """
+
+  action_index: int
+  at_minus_one: float
+  at_zero: float
+  at_plus_one: float
+
+
+def action_to_ctrl(action_map: np.ndarray, action: np.ndarray) -> np.ndarray:
+  """Maps actions (..., action_dim) to controls (..., num_actuators).
+
+  Args:
+    action_map: (num_actuators, 4) rows of (action index, ctrl at -1, at 0, at +1).
+    action: Actions in [-1, 1]; any leading batch shape.
+  """
+  index = action_map[:, 0].astype(int)
+  a = np.asarray(action, dtype=float)[..., index]
+  below = action_map[:, 2] + a * (action_map[:, 2] - action_map[:, 1])
+  above = action_map[:, 2] + a * (action_map[:, 3] - action_map[:, 2])
+  return np.where(a < 0, below, above)
+
+
+class SoftArm(abc.ABC):
+  """Base of the frozen spec dataclasses of every robot family."""
+
+  @property
+  @abc.abstractmethod
+  def name(self) -> str:
+    """Registry name, e.g. ``tendon-3``."""
+
+  @property
+  @abc.abstractmethod
+  def module_lengths(self) -> tuple[float, ...]:
+    """Rest length of each module (m)."""
+
+  @property
+  @abc.abstractmethod
+  def actuators_per_module(self) -> tuple[int, ...]:
+    """Number of action entries of each module."""
+
+  @property
+  @abc.abstractmethod
+  def control_timestep(self) -> float:
+    """Time between two actions (s)."""
+
+  @abc.abstractmethod
+  def actuator_maps(self) -> list[ActuatorMap]:
+    """One entry per MuJoCo actuator, in actuator order."""
+
+  @abc.abstractmethod
+  def _build(self, spec: mujoco.MjSpec) -> None:
+    """Adds the robot's options, assets, bodies, tendons and actuators to an empty spec."""
+
+  @abc.abstractmethod
+  def mirror_action(self, action: np.ndarray) -> np.ndarray:
+    """The action whose poses are the mirror images, under ``mirror_matrix``, of ``action``'s."""
+
+  @property
+  @abc.abstractmethod
+  def mirror_matrix(self) -> np.ndarray:
+    """A 3x3 reflection or rotation of world coordinates that maps the robot onto itself."""
+
+  @property
+  def num_modules(self) -> int:
+    return len(self.module_lengths)
+
+  @property
+  def length(self) -> float:
+    """Rest length of the whole arm (m)."""
+    return float(sum(self.module_lengths))
+
+  @property
+  def action_dim(self) -> int:
+    return int(sum(self.actuators_per_module))
+
+  def module_action_slices(self) -> list[slice]:
+    """The slice of the action vector that belongs to each module."""
+    ends = np.cumsum(self.actuators_per_module)
+    return [slice(int(end - size), int(end)) for end, size in zip(ends, self.actuators_per_module)]
+
+  def build_spec(self) -> mujoco.MjSpec:
+    """A fresh ``MjSpec`` of this robot, ready to compile or export."""
+    spec = mujoco.MjSpec()
+    spec.modelname = self.name
+    spec.compiler.degree = False
+    self._build(spec)
+    rows = [[m.action_index, m.at_minus_one, m.at_zero, m.at_plus_one]
+            for m in self.actuator_maps()]
+    spec.add_numeric(name=ACTION_MAP_NAME, data=np.asarray(rows, dtype=float).ravel().tolist())
+    return spec
+
+  def to_xml(self) -> str:
+    spec = self.build_spec()
+    spec.compile()
+    return spec.to_xml()
+
+  def compile(self) -> mujoco.MjModel:
+    return self.build_spec().compile()
+
+  def mass(self, model: mujoco.MjModel | None = None) -> float:
+    """Total mass of the moving arm (kg)."""
+    model = model if model is not None else self.compile()
+    return float(model.body_subtreemass[model.body("base").id] - model.body_mass[model.body("base").id])
+
+
+def check_positive(name: str, value: float) -> None:
+  if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+    raise ValueError(f"{name} must be a positive number, got {value!r}")

@@ -1,0 +1,204 @@
+"""``tendon-N``: a modular tendon-driven soft arm (SPEC 2.1).
+
+N modules of 50 mm hang from a fixed base under gravity. The backbone is a silicone rod cut into
+rigid segments whose elasticity comes from MuJoCo's ``mujoco.elasticity.cable`` plugin (the
+default, as ``<composite type="cable">`` expands) or, plugin-free, from ball joints of stiffness
+E·I / segment length. Each module has four cables at 90 degrees, routed as spatial tendons through
+holes in spacer disks (every 10 mm) and anchored at the module's tip; a cable of module k passes through all of
+modules 1..k-1, so actuating a distal module also bends the proximal ones.
+
+Action: two values per module in [-1, 1]. Value a of axis x pulls the +x cable with tension
+max(0, a)·Tmax and the -x cable with max(0, -a)·Tmax (the paper's antagonistic convention);
+likewise for y.
+"""
+
+import dataclasses
+import math
+import re
+
+import mujoco
+import numpy as np
+
+from softbench.robots import base
+from softbench.robots import chain
+
+MODULE_LENGTH = 0.05  # (m) Paper: "Each module has a length of 50 mm".
+MAX_MODULES = 10  # Largest N that builds; tendon-1 .. tendon-5 are the benchmark configurations.
+BACKBONES = ("cable", "joints")
+# Cables, as (name, angle around the arm in degrees, action axis, sign of the action that pulls it).
+_CABLES = (("xpos", 0.0, 0, +1), ("ypos", 90.0, 1, +1), ("xneg", 180.0, 0, -1),
+           ("yneg", 270.0, 1, -1))
+_MODULE_RGBA = ((0.90, 0.35, 0.25, 1), (0.95, 0.70, 0.20, 1), (0.35, 0.70, 0.35, 1),
+                (0.25, 0.55, 0.85, 1), (0.55, 0.40, 0.80, 1))
+_NAME_PATTERN = re.compile(r"^tendon-(\d+)$")
+
+
+@dataclasses.dataclass(frozen=True)
+class TendonArm(base.SoftArm):
+  """Frozen spec of a tendon-driven arm; every field has SI units.
+
+  Attributes:
+    num_modules: Number of 50 mm modules, 1 to 10.
+    module_length: Rest length of one module (m).
+    segments_per_module: Rigid segments per module (discretisation of the rod); a multiple of
+      ``disks_per_module``.
+    disks_per_module: Spacer disks per module, evenly spaced, the last one at the module's tip;
+      the cables run straight from disk to disk (a design parameter, not a discretisation).
+    radius: Backbone radius (m).
+    youngs_modulus: Young's modulus E of the silicone backbone (Pa).
+    poisson_ratio: Poisson's ratio; the torsion modulus is E / (2 (1 + nu)).
+    density: Backbone density (kg/m³), silicone rubber.
+    cable_offset: Distance of the cable holes from the backbone axis (m).
+    max_tension: Tmax, the cable tension at action ±1 (N).
+    damping: Rotational damping of every segment joint (N·m·s/rad).
+    armature: Added inertia of every joint DOF (kg·m²).
+    backbone: ``"cable"`` (cable plugin) or ``"joints"`` (ball-joint springs, no plugin).
+    timestep: Physics time step (s).
+    control_period: Time between two actions (s).
+  """
+
+  num_modules: int = 3
+  module_length: float = MODULE_LENGTH
+  segments_per_module: int = 5
+  disks_per_module: int = 5
+  radius: float = 0.005
+  youngs_modulus: float = 1.0e6
+  poisson_ratio: float = 0.5
+  density: float = 1100.0
+  cable_offset: float = 0.006
+  max_tension: float = 2.35
+  damping: float = 2.0e-4
+  armature: float = 1.0e-7
+  backbone: str = "cable"
+  timestep: float = 2.0e-3
+  control_period: float = 1.0
+
+  def __post_init__(self):
+    if (isinstance(self.num_modules, bool) or not isinstance(self.num_modules, int)
+        or not 1 <= self.num_modules <= MAX_MODULES):
+      raise ValueError(f"tendon arms have 1 to {MAX_MODULES} modules, got {self.num_modules!r}")
+    if not isinstance(self.disks_per_module, int) or self.disks_per_module < 1:
+      raise ValueError(f"disks_per_module must be a positive integer, "
+                       f"got {self.disks_per_module!r}")
+    if (not isinstance(self.segments_per_module, int) or self.segments_per_module < 1
+        or self.segments_per_module % self.disks_per_module):
+      raise ValueError(f"segments_per_module must be a positive multiple of disks_per_module "
+                       f"({self.disks_per_module}), got {self.segments_per_module!r}")
+    for field in ("module_length", "radius", "youngs_modulus", "density", "cable_offset",
+                  "max_tension", "timestep", "control_period"):
+      base.check_positive(field, getattr(self, field))
+    for field in ("damping", "armature"):
+      if not getattr(self, field) >= 0:
+        raise ValueError(f"{field} must be non-negative, got {getattr(self, field)!r}")
+    if not 0 <= self.poisson_ratio <= 0.5:
+      raise ValueError(f"poisson_ratio must lie in [0, 0.5], got {self.poisson_ratio!r}")
+    if self.backbone not in BACKBONES:
+      raise ValueError(f"unknown backbone {self.backbone!r}; choose one of {', '.join(BACKBONES)}")
+
+  @classmethod
+  def from_name(cls, name: str, **overrides) -> "TendonArm":
+    """``TendonArm.from_name('tendon-3')``; raises ValueError for a malformed name."""
+    match = _NAME_PATTERN.match(name)
+    if not match:
+      raise ValueError(f"malformed tendon arm name {name!r}; expected tendon-N with N from 1 to "
+                       f"{MAX_MODULES}")
+    return cls(num_modules=int(match.group(1)), **overrides)
+
+  @property
+  def name(self) -> str:
+    return f"tendon-{self.num_modules}"
+
+  @property
+  def module_lengths(self) -> tuple[float, ...]:
+    return (self.module_length,) * self.num_modules
+
+  @property
+  def actuators_per_module(self) -> tuple[int, ...]:
+    return (2,) * self.num_modules
+
+  @property
+  def control_timestep(self) -> float:
+    return self.control_period
+
+  @property
+  def bending_stiffness(self) -> float:
+    """E·I of the backbone (N·m²)."""
+    return self.youngs_modulus * math.pi * self.radius**4 / 4
+
+  @property
+  def segment_length(self) -> float:
+    return self.module_length / self.segments_per_module
+
+  def actuator_maps(self) -> list[base.ActuatorMap]:
+    maps = []
+    for module in range(self.num_modules):
+      for _, _, axis, sign in _CABLES:
+        index = 2 * module + axis
+        pulled_at_plus = self.max_tension if sign > 0 else 0.0
+        pulled_at_minus = self.max_tension if sign < 0 else 0.0
+        maps.append(base.ActuatorMap(index, pulled_at_minus, 0.0, pulled_at_plus))
+    return maps
+
+  def mirror_action(self, action: np.ndarray) -> np.ndarray:
+    # Every cable has an opposite one: -a pulls the opposite cables, i.e. the arm turned by
+    # 180 degrees about the vertical axis.
+    return -np.asarray(action)
+
+  @property
+  def mirror_matrix(self) -> np.ndarray:
+    return np.diag([-1.0, -1.0, 1.0])
+
+  def _build(self, spec: mujoco.MjSpec) -> None:
+    spec.option.timestep = self.timestep
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    # A chain's mass matrix is dense whatever its length; dense Jacobians measured 25% faster.
+    spec.option.jacobian = mujoco.mjtJacobian.mjJAC_DENSE
+    geometry = chain.ChainGeometry(self.module_lengths, self.segments_per_module, self.radius,
+                                   self.density)
+    if self.backbone == "cable":
+      spec.activate_plugin(chain.CABLE_PLUGIN)
+      plugin = spec.add_plugin(name="backbone_elasticity", plugin_name=chain.CABLE_PLUGIN,
+                               active=True)
+      torsion_modulus = self.youngs_modulus / (2 * (1 + self.poisson_ratio))
+      plugin.config = {"twist": repr(torsion_modulus), "bend": repr(self.youngs_modulus),
+                       "vmax": "0"}
+      joint_bending_stiffness = 0.0
+    else:
+      plugin = None
+      joint_bending_stiffness = self.bending_stiffness
+    joints = chain.SegmentJoints(bending_stiffness=joint_bending_stiffness, ball_damping=self.damping,
+                                 armature=self.armature)
+    base_body = spec.worldbody.add_body(name="base")
+    base_body.add_geom(name="base_plate", type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+                       size=(self.cable_offset * 2, 0.002, 0), pos=(0, 0, 0.002),
+                       rgba=(0.3, 0.3, 0.3, 1), contype=0, conaffinity=0)
+    rod = chain.add_chain(base_body, geometry, joints, _MODULE_RGBA * 2, plugin)
+    self._add_cables(spec, rod)
+
+  def _add_cables(self, spec: mujoco.MjSpec, rod: chain.Chain) -> None:
+    """Routes four cables per module from holes in the base through the spacer disks up to the
+    module's own last disk (its tip plate), where the cable is anchored, and gives each cable a
+    pulling motor."""
+    offsets = chain.ring_offsets(self.cable_offset, [angle for _, angle, _, _ in _CABLES])
+    spacing = self.module_length / self.disks_per_module
+    disks = [("base", 0.0)] + [
+        (f"module{module}_disk{disk}", ((module - 1) * self.disks_per_module + disk) * spacing)
+        for module in range(1, self.num_modules + 1)
+        for disk in range(1, self.disks_per_module + 1)]
+    holes = []  # [disk][cable]
+    for prefix, arc_length in disks:
+      holes.append([f"{prefix}_hole_{name}" for name, *_ in _CABLES])
+      for site, offset in zip(holes[-1], offsets):
+        rod.add_site(site, arc_length, offset, size=(0.0008, 0, 0), rgba=(0.2, 0.2, 0.2, 1))
+    for module in range(1, self.num_modules + 1):
+      rgba = _MODULE_RGBA[(module - 1) % len(_MODULE_RGBA)]
+      for cable, (cable_name, *_) in enumerate(_CABLES):
+        tendon = spec.add_tendon(name=f"module{module}_cable_{cable_name}", width=0.0005,
+                                 rgba=rgba)
+        for row in holes[:1 + module * self.disks_per_module]:
+          tendon.wrap_site(row[cable])
+        spec.add_actuator(
+            name=f"module{module}_cable_{cable_name}",
+            trntype=mujoco.mjtTrn.mjTRN_TENDON, target=tendon.name,
+            gear=(-1, 0, 0, 0, 0, 0),  # Cables pull: positive control shortens the tendon.
+            ctrllimited=mujoco.mjtLimited.mjLIMITED_TRUE, ctrlrange=(0, self.max_tension))
