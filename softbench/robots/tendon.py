@@ -48,7 +48,10 @@ class TendonArm(base.SoftArm):
     youngs_modulus: Young's modulus E of the silicone backbone (Pa).
     poisson_ratio: Poisson's ratio; the torsion modulus is E / (2 (1 + nu)).
     density: Backbone density (kg/m³), silicone rubber.
-    cable_offset: Distance of the cable holes from the backbone axis (m).
+    cable_offset: Distance of a cable from the backbone axis inside its own module (m).
+    pass_through_offset: Distance from the axis of the holes through which a cable crosses the
+      proximal modules on its way to its own (m); closer to the axis than ``cable_offset`` so
+      that a distal cable loads proximal modules with a third of the moment, not all of it.
     max_tension: Tmax, the cable tension at action ±1 (N).
     damping: Rotational damping of every segment joint (N·m·s/rad).
     armature: Added inertia of every joint DOF (kg·m²).
@@ -66,9 +69,10 @@ class TendonArm(base.SoftArm):
   poisson_ratio: float = 0.5
   density: float = 1100.0
   cable_offset: float = 0.006
+  pass_through_offset: float = 0.002
   max_tension: float = 2.35
-  damping: float = 2.0e-4
-  armature: float = 1.0e-7
+  damping: float = 2.0e-3
+  armature: float = 1.0e-6
   backbone: str = "cable"
   timestep: float = 2.0e-3
   control_period: float = 1.0
@@ -85,7 +89,7 @@ class TendonArm(base.SoftArm):
       raise ValueError(f"segments_per_module must be a positive multiple of disks_per_module "
                        f"({self.disks_per_module}), got {self.segments_per_module!r}")
     for field in ("module_length", "radius", "youngs_modulus", "density", "cable_offset",
-                  "max_tension", "timestep", "control_period"):
+                  "pass_through_offset", "max_tension", "timestep", "control_period"):
       base.check_positive(field, getattr(self, field))
     for field in ("damping", "armature"):
       if not getattr(self, field) >= 0:
@@ -176,27 +180,37 @@ class TendonArm(base.SoftArm):
     self._add_cables(spec, rod)
 
   def _add_cables(self, spec: mujoco.MjSpec, rod: chain.Chain) -> None:
-    """Routes four cables per module from holes in the base through the spacer disks up to the
-    module's own last disk (its tip plate), where the cable is anchored, and gives each cable a
-    pulling motor."""
-    offsets = chain.ring_offsets(self.cable_offset, [angle for _, angle, _, _ in _CABLES])
+    """Routes four cables per module from the base through the spacer disks up to the module's
+    own last disk (its tip plate), where the cable is anchored, and gives each cable a pulling
+    motor. Inside its own module a cable runs through the outer holes, at ``cable_offset``; on
+    its way through proximal modules it runs through inner holes, at ``pass_through_offset``."""
+    angles = [angle for _, angle, _, _ in _CABLES]
+    rings = {"outer": chain.ring_offsets(self.cable_offset, angles),
+             "inner": chain.ring_offsets(self.pass_through_offset, angles)}
     spacing = self.module_length / self.disks_per_module
-    disks = [("base", 0.0)] + [
-        (f"module{module}_disk{disk}", ((module - 1) * self.disks_per_module + disk) * spacing)
+    disks = [("base", 0.0, 0)] + [
+        (f"module{module}_disk{disk}", ((module - 1) * self.disks_per_module + disk) * spacing,
+         module)
         for module in range(1, self.num_modules + 1)
         for disk in range(1, self.disks_per_module + 1)]
-    holes = []  # [disk][cable]
-    for prefix, arc_length in disks:
-      holes.append([f"{prefix}_hole_{name}" for name, *_ in _CABLES])
-      for site, offset in zip(holes[-1], offsets):
-        rod.add_site(site, arc_length, offset, size=(0.0008, 0, 0), rgba=(0.2, 0.2, 0.2, 1))
+    holes = []  # [disk][ring][cable]
+    for prefix, arc_length, module in disks:
+      holes.append({})
+      # The base and every disk of a module feed the next module's cables inwards, except the
+      # tip plate of the last module which no cable passes.
+      for ring in ("outer", "inner") if module < self.num_modules else ("outer",):
+        holes[-1][ring] = [f"{prefix}_{ring}_hole_{name}" for name, *_ in _CABLES]
+        for site, offset in zip(holes[-1][ring], rings[ring]):
+          rod.add_site(site, arc_length, offset, size=(0.0008, 0, 0), rgba=(0.2, 0.2, 0.2, 1))
     for module in range(1, self.num_modules + 1):
       rgba = _MODULE_RGBA[(module - 1) % len(_MODULE_RGBA)]
+      own_first_disk = 1 + (module - 1) * self.disks_per_module
       for cable, (cable_name, *_) in enumerate(_CABLES):
         tendon = spec.add_tendon(name=f"module{module}_cable_{cable_name}", width=0.0005,
                                  rgba=rgba)
-        for row in holes[:1 + module * self.disks_per_module]:
-          tendon.wrap_site(row[cable])
+        for disk, disk_holes in enumerate(holes[:1 + module * self.disks_per_module]):
+          ring = "outer" if disk >= own_first_disk or module == 1 else "inner"
+          tendon.wrap_site(disk_holes[ring][cable])
         spec.add_actuator(
             name=f"module{module}_cable_{cable_name}",
             trntype=mujoco.mjtTrn.mjTRN_TENDON, target=tendon.name,

@@ -1,0 +1,62 @@
+"""``SoftArmPhysics``: dm_control physics of a softbench arm, with named accessors.
+
+Everything it needs comes from the MJCF itself (tip sites ``module{k}_tip`` and the
+``action_map`` numeric), so it drives an exported model file as well as a freshly built robot.
+"""
+
+import numpy as np
+from dm_control import mujoco
+
+from softbench.robots import base
+from softbench.robots import chain
+
+
+class SoftArmPhysics(mujoco.Physics):
+  """Physics with per-module pose accessors and the robot's action map."""
+
+  @classmethod
+  def from_robot(cls, robot: base.SoftArm) -> "SoftArmPhysics":
+    return cls.from_xml_string(robot.to_xml())
+
+  @property
+  def action_map(self) -> np.ndarray:
+    """(num_actuators, 4): action index, then control at action -1, 0 and +1."""
+    return self.model.numeric(base.ACTION_MAP_NAME).data.reshape(-1, 4)
+
+  @property
+  def action_dim(self) -> int:
+    return int(self.action_map[:, 0].max()) + 1
+
+  @property
+  def num_modules(self) -> int:
+    names = {self.model.site(i).name for i in range(self.model.nsite)}
+    return sum(1 for k in range(1, len(names) + 1) if chain.tip_site_name(k) in names)
+
+  def set_action(self, action: np.ndarray) -> None:
+    """Sets the controls of every actuator from an action in [-1, 1]^action_dim.
+
+    Raises:
+      ValueError: wrong shape, or an action entry that is NaN, infinite or outside [-1, 1].
+    """
+    action = np.asarray(action, dtype=float)
+    if action.shape != (self.action_dim,):
+      raise ValueError(f"action must have shape ({self.action_dim},), got {action.shape}")
+    if not np.all(np.isfinite(action)):
+      raise ValueError(f"action contains NaN or infinite values: {action.tolist()}")
+    if np.any(np.abs(action) > 1.0 + 1e-9):
+      raise ValueError(f"action entries must lie in [-1, 1], got {action.tolist()}")
+    self.data.ctrl[:] = base.action_to_ctrl(self.action_map, np.clip(action, -1.0, 1.0))
+
+  def module_tip_position(self, module: int) -> np.ndarray:
+    """World position (m) of module ``module``'s tip (1-based)."""
+    return self.named.data.site_xpos[chain.tip_site_name(module)].copy()
+
+  def module_orientation_vector(self, module: int) -> np.ndarray:
+    """Unit arm axis at module ``module``'s tip, in world coordinates."""
+    return self.named.data.site_xmat[chain.tip_site_name(module)].reshape(3, 3)[:, 2].copy()
+
+  def module_poses(self) -> np.ndarray:
+    """(num_modules, 6): tip position (m) and orientation vector of every module."""
+    return np.stack([np.concatenate([self.module_tip_position(k),
+                                     self.module_orientation_vector(k)])
+                     for k in range(1, self.num_modules + 1)])
