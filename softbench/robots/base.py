@@ -79,6 +79,10 @@ class SoftArm(abc.ABC):
   def mirror_action(self, action: np.ndarray) -> np.ndarray:
     """The action whose poses are the mirror images, under ``mirror_matrix``, of ``action``'s."""
 
+  @abc.abstractmethod
+  def bend_action_pattern(self, module: int) -> np.ndarray:
+    """The module's own action entries that bend it fully towards world +x."""
+
   @property
   @abc.abstractmethod
   def mirror_matrix(self) -> np.ndarray:

@@ -128,6 +128,11 @@ class PneumaticArm(base.SoftArm):
   def mirror_matrix(self) -> np.ndarray:
     return np.diag([1.0, -1.0, 1.0])
 
+  def bend_action_pattern(self, module: int) -> np.ndarray:
+    # Empty the bellows on the +x side and fill those on the -x side.
+    cosines = np.cos(np.deg2rad(self.bellows_angles(module)))
+    return -np.sign(np.round(cosines, 9))
+
   def _build(self, spec: mujoco.MjSpec) -> None:
     spec.option.timestep = self.timestep
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST

@@ -152,6 +152,9 @@ class TendonArm(base.SoftArm):
   def mirror_matrix(self) -> np.ndarray:
     return np.diag([-1.0, -1.0, 1.0])
 
+  def bend_action_pattern(self, module: int) -> np.ndarray:
+    return np.array([1.0, 0.0])  # Pull the +x cable with Tmax.
+
   def _build(self, spec: mujoco.MjSpec) -> None:
     spec.option.timestep = self.timestep
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST

@@ -1,0 +1,74 @@
+"""The ``softbench`` command line. It parses arguments and calls the library; a bad input gets
+one line on stderr and exit code 2."""
+
+import argparse
+import pathlib
+import sys
+
+from softbench import robots
+from softbench.robots import export as model_export
+
+EXIT_USAGE = 2
+
+
+def _robot_overrides(args: argparse.Namespace) -> dict:
+  return {"module_length": args.module_length} if args.module_length is not None else {}
+
+
+def _describe(robot: robots.SoftArm) -> str:
+  return (f"{robot.name:<15} {robot.num_modules:>7} {robot.action_dim:>10} "
+          f"{robot.length * 1000:>9.0f} {robot.mass() * 1000:>8.1f}")
+
+
+def _robots(args: argparse.Namespace) -> None:
+  header = f"{'robot':<15} {'modules':>7} {'action dim':>10} {'length mm':>9} {'mass g':>8}"
+  if args.name is None:
+    print(header)
+    for name in robots.BENCHMARK_ROBOTS:
+      print(_describe(robots.make(name, **_robot_overrides(args))))
+    return
+  robot = robots.make(args.name, **_robot_overrides(args))
+  print(header)
+  print(_describe(robot))
+  print(f"\ncontrol period: {robot.control_timestep} s; actions per module: "
+        f"{', '.join(map(str, robot.actuators_per_module))}")
+  for field, value in model_export._fields(robot):
+    print(f"  {field} = {value}")
+
+
+def _models_export(args: argparse.Namespace) -> None:
+  out = pathlib.Path(args.out)
+  for name in robots.BENCHMARK_ROBOTS:
+    for path in model_export.export(robots.make(name), out, args.measure_speed):
+      print(path)
+
+
+def build_parser() -> argparse.ArgumentParser:
+  parser = argparse.ArgumentParser(prog="softbench", description=__doc__.split(".")[0] + ".")
+  commands = parser.add_subparsers(dest="command", required=True)
+  robots_parser = commands.add_parser("robots", help="list the benchmark robots or describe one")
+  robots_parser.add_argument("name", nargs="?", help="e.g. tendon-3 or pneumatic-433")
+  robots_parser.add_argument("--module-length", type=float, help="module length in m")
+  robots_parser.set_defaults(run=_robots)
+  models = commands.add_parser("models", help="exported MJCF models")
+  models_commands = models.add_subparsers(dest="models_command", required=True)
+  export_parser = models_commands.add_parser("export", help="write models/<name>/ for every robot")
+  export_parser.add_argument("--out", default="models", help="output folder (default: models)")
+  export_parser.add_argument("--measure-speed", action="store_true",
+                             help="also measure simulation speed into speed.json")
+  export_parser.set_defaults(run=_models_export)
+  return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+  args = build_parser().parse_args(argv)
+  try:
+    args.run(args)
+  except (ValueError, FileNotFoundError) as error:
+    print(f"softbench: error: {error}", file=sys.stderr)
+    return EXIT_USAGE
+  return 0
+
+
+if __name__ == "__main__":
+  sys.exit(main())

@@ -1,0 +1,124 @@
+"""Measurements of a robot's physics, as stated in the model READMEs and ``softbench robots``.
+
+Everything runs headless on the CPU with MuJoCo's own ``rollout``; all randomness comes from
+the seed passed in, so the same robot gives the same figures.
+"""
+
+import dataclasses
+import time
+
+import mujoco
+import numpy as np
+from mujoco import rollout
+
+from softbench.robots import base
+from softbench.robots import chain
+
+SETTLE_SECONDS = 3.0  # (s) Time given to reach equilibrium after a change of action.
+SETTLED_TOLERANCE = 0.001  # (m) Tip distance from its final position that counts as settled.
+WORKSPACE_SAMPLES = 200  # Random actions whose poses outline the workspace.
+DISCRETISATION_REFINEMENT = 4  # The finer model has this many times more segments.
+
+
+def _state(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
+  state = np.empty(mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS))
+  mujoco.mj_getState(model, data, state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+  return state
+
+
+def tip_trajectory(robot: base.SoftArm, actions: np.ndarray, hold_seconds: float,
+                   model: mujoco.MjModel | None = None) -> np.ndarray:
+  """Every module's tip position (steps, modules, 3) in m, each action held ``hold_seconds``.
+
+  Raises:
+    FloatingPointError: the simulation became unstable.
+  """
+  model = model if model is not None else robot.compile()
+  data = mujoco.MjData(model)
+  action_map = np.array([dataclasses.astuple(m) for m in robot.actuator_maps()])
+  steps = int(round(hold_seconds / model.opt.timestep))
+  controls = np.repeat(base.action_to_ctrl(action_map, np.atleast_2d(actions)), steps, axis=0)
+  sites = [model.site(chain.tip_site_name(k)).id for k in range(1, robot.num_modules + 1)]
+  _, sensordata = None, None
+  states, _ = rollout.rollout(model, data, _state(model, data)[None], controls[None])
+  if data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number or not np.all(np.isfinite(states)):
+    raise FloatingPointError(f"{robot.name}: simulation unstable")
+  positions = np.empty((len(controls), len(sites), 3))
+  for step, state in enumerate(states[0]):
+    mujoco.mj_setState(model, data, state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+    mujoco.mj_kinematics(model, data)
+    positions[step] = data.site_xpos[sites]
+  return positions
+
+
+def equilibrium(robot: base.SoftArm, action: np.ndarray, seconds: float = SETTLE_SECONDS,
+                model: mujoco.MjModel | None = None) -> np.ndarray:
+  """Tip positions (modules, 3) in m after holding ``action`` for ``seconds`` from rest."""
+  return tip_trajectory(robot, action, seconds, model)[-1]
+
+
+def full_bend_action(robot: base.SoftArm, module: int) -> np.ndarray:
+  """The action that bends ``module`` fully towards world +x and leaves the others at zero."""
+  action = np.zeros(robot.action_dim)
+  action[robot.module_action_slices()[module - 1]] = robot.bend_action_pattern(module)
+  return action
+
+
+def bend_angle(robot: base.SoftArm, action: np.ndarray, module: int = 1,
+               seconds: float = SETTLE_SECONDS) -> float:
+  """Angle (deg) between a module's tip axis at rest and after holding ``action``."""
+  model = robot.compile()
+  data = mujoco.MjData(model)
+  mujoco.mj_kinematics(model, data)
+  site = model.site(chain.tip_site_name(module)).id
+  rest_axis = data.site_xmat[site].reshape(3, 3)[:, 2].copy()
+  action_map = np.array([dataclasses.astuple(m) for m in robot.actuator_maps()])
+  data.ctrl[:] = base.action_to_ctrl(action_map, action)
+  mujoco.mj_step(model, data, nstep=int(round(seconds / model.opt.timestep)))
+  axis = data.site_xmat[site].reshape(3, 3)[:, 2]
+  return float(np.degrees(np.arccos(np.clip(axis @ rest_axis, -1.0, 1.0))))
+
+
+def settling_time(robot: base.SoftArm, seconds: float = SETTLE_SECONDS) -> float:
+  """Seconds until the end effector stays within ``SETTLED_TOLERANCE`` of its final position
+  after a step from rest to full actuation of module 1."""
+  tips = tip_trajectory(robot, full_bend_action(robot, 1), seconds)[:, -1]
+  moving = np.flatnonzero(np.linalg.norm(tips - tips[-1], axis=1) > SETTLED_TOLERANCE)
+  return 0.0 if len(moving) == 0 else float((moving[-1] + 1) * robot.compile().opt.timestep)
+
+
+def workspace_extent(robot: base.SoftArm, seed: int = 0,
+                     samples: int = WORKSPACE_SAMPLES) -> np.ndarray:
+  """(3, 2) min and max (m) of the end effector over random actions, each held one control
+  period, recorded at the end of every period as in motor babbling."""
+  actions = np.random.default_rng(seed).uniform(-1, 1, (samples, robot.action_dim))
+  steps = int(round(robot.control_timestep / robot.compile().opt.timestep))
+  tips = tip_trajectory(robot, actions, robot.control_timestep)[steps - 1::steps, -1]
+  return np.stack([tips.min(axis=0), tips.max(axis=0)], axis=1)
+
+
+def simulation_speed(robot: base.SoftArm, seconds: float = 5.0, seed: int = 0) -> dict:
+  """Physics steps per second and real-time factor on one thread, under random actuation."""
+  model = robot.compile()
+  periods = max(1, int(round(seconds / robot.control_timestep)))
+  actions = np.random.default_rng(seed).uniform(-1, 1, (periods, robot.action_dim))
+  action_map = np.array([dataclasses.astuple(m) for m in robot.actuator_maps()])
+  steps = int(round(robot.control_timestep / model.opt.timestep))
+  controls = np.repeat(base.action_to_ctrl(action_map, actions), steps, axis=0)[None]
+  data = mujoco.MjData(model)
+  start = time.perf_counter()
+  rollout.rollout(model, data, _state(model, data)[None], controls)
+  elapsed = time.perf_counter() - start
+  return {"steps_per_second": controls.shape[1] / elapsed,
+          "real_time_factor": controls.shape[1] * model.opt.timestep / elapsed}
+
+
+def discretisation_error(robot: base.SoftArm, finer: base.SoftArm, actions: np.ndarray) -> np.ndarray:
+  """End-effector distance between ``robot`` and ``finer`` at equilibrium, in % of the arm
+  length, for each action."""
+  errors = []
+  for action in actions:
+    coarse_tip = equilibrium(robot, action)[-1]
+    fine_tip = equilibrium(finer, action)[-1]
+    errors.append(100.0 * np.linalg.norm(coarse_tip - fine_tip) / robot.length)
+  return np.array(errors)

@@ -1,0 +1,61 @@
+"""The committed models regenerate byte for byte; the CLI lists robots and refuses bad input."""
+
+import pathlib
+import shutil
+
+import mujoco
+import pytest
+
+from softbench import cli
+from softbench import robots
+from softbench.robots import export
+
+MODELS = pathlib.Path(__file__).resolve().parents[1] / "models"
+
+
+def test_committed_models_are_identical_to_regenerated(tmp_path):
+  for name in robots.BENCHMARK_ROBOTS:
+    # Speed is measured only on request; reuse the committed figures.
+    committed_speed = MODELS / name / export.SPEED_FILE
+    if committed_speed.exists():
+      (tmp_path / name).mkdir()
+      shutil.copy(committed_speed, tmp_path / name / export.SPEED_FILE)
+  assert cli.main(["models", "export", "--out", str(tmp_path)]) == 0
+  regenerated = sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*") if p.is_file())
+  committed = sorted(p.relative_to(MODELS) for p in MODELS.rglob("*") if p.is_file())
+  assert regenerated == committed
+  for relative in committed:
+    assert (tmp_path / relative).read_text() == (MODELS / relative).read_text(), relative
+
+
+@pytest.mark.parametrize("name", robots.BENCHMARK_ROBOTS)
+def test_exported_scene_compiles(name):
+  model = mujoco.MjModel.from_xml_path(str(MODELS / name / "scene.xml"))
+  assert model.nu == len(robots.make(name).actuator_maps())
+  assert model.geom("floor").id >= 0
+
+
+def test_cli_lists_every_benchmark_robot(capsys):
+  assert cli.main(["robots"]) == 0
+  rows = capsys.readouterr().out.splitlines()[1:]
+  assert [row.split()[0] for row in rows] == list(robots.BENCHMARK_ROBOTS)
+  assert rows[0].split()[1:3] == ["1", "2"]  # tendon-1: one module, two action entries.
+
+
+def test_cli_describes_any_valid_tendon_arm(capsys):
+  assert cli.main(["robots", "tendon-7"]) == 0
+  assert capsys.readouterr().out.splitlines()[1].split()[:3] == ["tendon-7", "7", "14"]
+
+
+@pytest.mark.parametrize("argv", [
+    ["robots", "tendon-0"], ["robots", "tendon-x"], ["robots", "tendon-1000"],
+    ["robots", "unicorn"], ["robots", "tendon-3", "--module-length", "-0.05"],
+])
+def test_cli_refuses_bad_input_with_one_line_and_exit_code_2(argv, capsys):
+  assert cli.main(argv) == cli.EXIT_USAGE
+  captured = capsys.readouterr()
+  assert captured.out == ""
+  lines = captured.err.strip().splitlines()
+  assert len(lines) == 1 and lines[0].startswith("softbench: error: ")
+  with pytest.raises(ValueError, match=lines[0].removeprefix("softbench: error: ")[:20]):
+    robots.make(argv[1], **({"module_length": -0.05} if len(argv) > 2 else {}))
