@@ -111,9 +111,11 @@ class PneumaticArm(base.SoftArm):
     return [360.0 * i / count for i in range(count)]
 
   def actuator_maps(self) -> list[base.ActuatorMap]:
+    # Controls are length changes (m) from the characteristic length, so that the default
+    # control 0 of a fresh simulation is zero pressure.
     ratios = pressure_to_length_ratio(action_to_pressure(np.array([-1.0, 0.0, 1.0])))
-    lengths = ratios * self.module_length
-    return [base.ActuatorMap(index, *lengths) for index in range(self.action_dim)]
+    changes = (ratios - 1.0) * self.module_length
+    return [base.ActuatorMap(index, *changes) for index in range(self.action_dim)]
 
   def mirror_action(self, action: np.ndarray) -> np.ndarray:
     # Reflection y -> -y maps a bellows at angle phi onto the one at -phi.
@@ -153,7 +155,8 @@ class PneumaticArm(base.SoftArm):
 
   def _add_bellows(self, spec: mujoco.MjSpec, rod: chain.Chain) -> None:
     """Each bellows: a tendon through sites at every segment midpoint of its module, from the
-    module's base plate to its tip plate, driven by a position actuator on its length."""
+    module's base plate to its tip plate, driven by a position actuator on its length whose
+    control is the change of rest length: force = k (L0 + ctrl - length) - c · velocity."""
     lengths = [m.at_minus_one for m in self.actuator_maps()], [m.at_plus_one
                                                                 for m in self.actuator_maps()]
     index = 0
@@ -174,7 +177,8 @@ class PneumaticArm(base.SoftArm):
             name=name, trntype=mujoco.mjtTrn.mjTRN_TENDON, target=name,
             gaintype=mujoco.mjtGain.mjGAIN_FIXED, biastype=mujoco.mjtBias.mjBIAS_AFFINE,
             gainprm=[self.bellows_stiffness] + [0] * 9,
-            biasprm=[0, -self.bellows_stiffness, -self.bellows_damping] + [0] * 7,
+            biasprm=[self.bellows_stiffness * self.module_length, -self.bellows_stiffness,
+                     -self.bellows_damping] + [0] * 7,
             ctrllimited=mujoco.mjtLimited.mjLIMITED_TRUE,
             ctrlrange=(lengths[0][index], lengths[1][index]))
         index += 1
