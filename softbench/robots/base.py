@@ -106,6 +106,12 @@ class SoftArm(abc.ABC):
     ends = np.cumsum(self.actuators_per_module)
     return [slice(int(end - size), int(end)) for end, size in zip(ends, self.actuators_per_module)]
 
+  def refined(self, factor: int) -> "SoftArm":
+    """The same robot with ``factor`` times more segments and a time step ``factor`` times
+    shorter, to measure discretisation error."""
+    return dataclasses.replace(self, segments_per_module=self.segments_per_module * factor,
+                               timestep=self.timestep / factor)
+
   def build_spec(self) -> mujoco.MjSpec:
     """A fresh ``MjSpec`` of this robot, ready to compile or export."""
     spec = mujoco.MjSpec()

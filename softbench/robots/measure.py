@@ -39,7 +39,6 @@ def tip_trajectory(robot: base.SoftArm, actions: np.ndarray, hold_seconds: float
   steps = int(round(hold_seconds / model.opt.timestep))
   controls = np.repeat(base.action_to_ctrl(action_map, np.atleast_2d(actions)), steps, axis=0)
   sites = [model.site(chain.tip_site_name(k)).id for k in range(1, robot.num_modules + 1)]
-  _, sensordata = None, None
   states, _ = rollout.rollout(model, data, _state(model, data)[None], controls[None])
   if data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number or not np.all(np.isfinite(states)):
     raise FloatingPointError(f"{robot.name}: simulation unstable")
@@ -113,12 +112,21 @@ def simulation_speed(robot: base.SoftArm, seconds: float = 5.0, seed: int = 0) -
           "real_time_factor": controls.shape[1] * model.opt.timestep / elapsed}
 
 
-def discretisation_error(robot: base.SoftArm, finer: base.SoftArm, actions: np.ndarray) -> np.ndarray:
-  """End-effector distance between ``robot`` and ``finer`` at equilibrium, in % of the arm
-  length, for each action."""
-  errors = []
-  for action in actions:
-    coarse_tip = equilibrium(robot, action)[-1]
-    fine_tip = equilibrium(finer, action)[-1]
-    errors.append(100.0 * np.linalg.norm(coarse_tip - fine_tip) / robot.length)
-  return np.array(errors)
+def discretisation_actions(robot: base.SoftArm, seed: int = 0, random_actions: int = 3,
+                           random_scale: float = 0.5) -> np.ndarray:
+  """Full bending of each module alone, and a few random actions scaled by ``random_scale``."""
+  rng = np.random.default_rng(seed)
+  actions = [full_bend_action(robot, k) for k in range(1, robot.num_modules + 1)]
+  actions += list(random_scale * rng.uniform(-1, 1, (random_actions, robot.action_dim)))
+  return np.array(actions)
+
+
+def discretisation_error(robot: base.SoftArm, actions: np.ndarray,
+                         factor: int = DISCRETISATION_REFINEMENT) -> np.ndarray:
+  """End-effector distance (m) at equilibrium between ``robot`` and ``robot.refined(factor)``,
+  for each action."""
+  finer = robot.refined(factor)
+  coarse_model, fine_model = robot.compile(), finer.compile()
+  return np.array([np.linalg.norm(equilibrium(robot, action, model=coarse_model)[-1]
+                                  - equilibrium(finer, action, model=fine_model)[-1])
+                   for action in actions])

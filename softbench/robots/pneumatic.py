@@ -54,7 +54,8 @@ class PneumaticArm(base.SoftArm):
     backbone_bending_stiffness: E·I of the backbone (N·m²): the plates' resistance to bending and
       twist beyond what the bellows give.
     backbone_axial_stiffness: Axial stiffness of each backbone slide joint (N/m).
-    joint_damping: Damping of the backbone's ball joints (N·m·s/rad) and slides (N·s/m).
+    backbone_axial_damping: Damping of each backbone slide joint (N·s/m).
+    joint_damping: Damping of the backbone's ball joints (N·m·s/rad).
     armature: Added inertia of every joint DOF (kg·m² or kg).
     timestep: Physics time step (s).
     control_period: Time between two actions (s); the paper actuates the robot at 5 Hz.
@@ -71,7 +72,8 @@ class PneumaticArm(base.SoftArm):
   backbone_radius: float = 0.008
   backbone_bending_stiffness: float = 0.02
   backbone_axial_stiffness: float = 50.0
-  joint_damping: float = 5.0e-3
+  backbone_axial_damping: float = 2.0
+  joint_damping: float = 0.05
   armature: float = 1.0e-5
   timestep: float = 1.0e-3
   control_period: float = 0.2
@@ -145,7 +147,7 @@ class PneumaticArm(base.SoftArm):
     joints = chain.SegmentJoints(
         bending_stiffness=self.backbone_bending_stiffness, ball_damping=self.joint_damping,
         armature=self.armature, slide_stiffness=self.backbone_axial_stiffness,
-        slide_damping=self.joint_damping)
+        slide_damping=self.backbone_axial_damping)
     base_body = spec.worldbody.add_body(name="base")
     base_body.add_geom(name="base_plate", type=mujoco.mjtGeom.mjGEOM_CYLINDER,
                        size=(self.bellows_offset + self.bellows_radius, 0.003, 0),
