@@ -2,7 +2,7 @@
 
 The rod is discretised in a staggered way. Joints sit at arc lengths (i - 1/2)·l of every module
 (l its segment length); each joint stands for the rod between two segment midpoints, and a rigid
-body spans from one joint to the next. Module boundaries and spacer disks therefore fall at body
+body spans from one joint to the next. Module boundaries therefore fall at body
 midpoints, where a body's orientation equals the rod's tangent to second order, and every joint's
 stiffness is E·I over the distance between the origins of the two bodies it joins (the cable
 plugin's own rule) with that distance equal to l everywhere. Tip positions converge with the

@@ -110,6 +110,11 @@ def scene(robot: base.SoftArm) -> str:
                        floor_z=-robot.length * 1.6)
 
 
+def model_files(robot: base.SoftArm) -> dict[str, str]:
+  """The robot's MJCF and its scene, by file name."""
+  return {f"{robot.name}.xml": robot.to_xml(), "scene.xml": scene(robot)}
+
+
 def export(robot: base.SoftArm, out: pathlib.Path, measure_speed_now: bool = False) -> list[pathlib.Path]:
   """Writes the robot's folder under ``out`` and returns the files written."""
   folder = out / robot.name
@@ -120,8 +125,8 @@ def export(robot: base.SoftArm, out: pathlib.Path, measure_speed_now: bool = Fal
     write_atomically(speed_path, json.dumps(speed, indent=2) + "\n")
   elif speed_path.exists():
     speed = json.loads(speed_path.read_text())
-  files = {folder / f"{robot.name}.xml": robot.to_xml(), folder / "scene.xml": scene(robot),
-           folder / "README.md": readme(robot, speed)}
+  files = {folder / name: text for name, text in model_files(robot).items()}
+  files[folder / "README.md"] = readme(robot, speed)
   for path, text in files.items():
     write_atomically(path, text)
   return list(files) + ([speed_path] if speed else [])

@@ -4,8 +4,9 @@ N modules of 50 mm hang from a fixed base under gravity. The backbone is a silic
 rigid segments whose elasticity comes from MuJoCo's ``mujoco.elasticity.cable`` plugin (the
 default, as ``<composite type="cable">`` expands) or, plugin-free, from ball joints of stiffness
 E·I / segment length. Each module has four cables at 90 degrees, routed as spatial tendons through
-holes in spacer disks (every 10 mm) and anchored at the module's tip; a cable of module k passes through all of
-modules 1..k-1, so actuating a distal module also bends the proximal ones.
+holes near both ends of every segment (a channel along the rod) and anchored at the module's
+tip; a cable of module k passes through all of modules 1..k-1, closer to the axis, so actuating
+a distal module also bends the proximal ones.
 
 Action: two values per module in [-1, 1]. Value a of axis x pulls the +x cable with tension
 max(0, a)·Tmax and the -x cable with max(0, -a)·Tmax (the paper's antagonistic convention);
@@ -40,10 +41,12 @@ class TendonArm(base.SoftArm):
   Attributes:
     num_modules: Number of 50 mm modules, 1 to 10.
     module_length: Rest length of one module (m).
-    segments_per_module: Rigid segments per module (discretisation of the rod); a multiple of
-      ``disks_per_module``.
-    disks_per_module: Spacer disks per module, evenly spaced, the last one at the module's tip;
-      the cables run straight from disk to disk (a design parameter, not a discretisation).
+    segments_per_module: Rigid segments per module (discretisation of the rod).
+    hole_inset: Distance of a cable hole from the nearest joint, as a fraction of the segment
+      length. The holes on the concave side of a joint meet when it bends by
+      2·atan(hole_inset · segment length / cable_offset), 23 degrees per joint or about 113
+      degrees per module by default: a bending limit, like spacer disks touching, that holds at
+      every discretisation because the inset scales with the segment.
     radius: Backbone radius (m).
     youngs_modulus: Young's modulus E of the silicone backbone (Pa).
     poisson_ratio: Poisson's ratio; the torsion modulus is E / (2 (1 + nu)).
@@ -67,14 +70,14 @@ class TendonArm(base.SoftArm):
   num_modules: int = 3
   module_length: float = MODULE_LENGTH
   segments_per_module: int = 5
-  disks_per_module: int = 5
+  hole_inset: float = 0.12
   radius: float = 0.005
   youngs_modulus: float = 1.0e6
   poisson_ratio: float = 0.5
   density: float = 1100.0
   cable_offset: float = 0.006
   pass_through_offset: float = 0.002
-  max_tension: float = 2.35
+  max_tension: float = 2.56  # Bends tendon-1 by 90.0 deg (bisection on measure.bend_angle).
   damping: float = 2.0e-3
   medium_viscosity: float = 0.1
   armature: float = 1.0e-6
@@ -86,13 +89,11 @@ class TendonArm(base.SoftArm):
     if (isinstance(self.num_modules, bool) or not isinstance(self.num_modules, int)
         or not 1 <= self.num_modules <= MAX_MODULES):
       raise ValueError(f"tendon arms have 1 to {MAX_MODULES} modules, got {self.num_modules!r}")
-    if not isinstance(self.disks_per_module, int) or self.disks_per_module < 1:
-      raise ValueError(f"disks_per_module must be a positive integer, "
-                       f"got {self.disks_per_module!r}")
-    if (not isinstance(self.segments_per_module, int) or self.segments_per_module < 1
-        or self.segments_per_module % self.disks_per_module):
-      raise ValueError(f"segments_per_module must be a positive multiple of disks_per_module "
-                       f"({self.disks_per_module}), got {self.segments_per_module!r}")
+    if not isinstance(self.segments_per_module, int) or self.segments_per_module < 1:
+      raise ValueError(f"segments_per_module must be a positive integer, "
+                       f"got {self.segments_per_module!r}")
+    if not 0 < self.hole_inset < 0.5:
+      raise ValueError(f"hole_inset must lie strictly between 0 and 0.5, got {self.hole_inset!r}")
     for field in ("module_length", "radius", "youngs_modulus", "density", "cable_offset",
                   "pass_through_offset", "max_tension", "timestep", "control_period"):
       base.check_positive(field, getattr(self, field))
@@ -191,39 +192,52 @@ class TendonArm(base.SoftArm):
     self._add_cables(spec, rod)
 
   def _add_cables(self, spec: mujoco.MjSpec, rod: chain.Chain) -> None:
-    """Routes four cables per module from the base through the spacer disks up to the module's
-    own last disk (its tip plate), where the cable is anchored, and gives each cable a pulling
-    motor. Inside its own module a cable runs through the outer holes, at ``cable_offset``; on
-    its way through proximal modules it runs through inner holes, at ``pass_through_offset``."""
+    """Routes four cables per module along the rod to the module's tip, where each is anchored,
+    and gives each cable a pulling motor.
+
+    A cable runs in a channel: every segment holds it at two holes, ``hole_inset`` of a segment
+    from either joint, so the short stretch crossing a joint passes it at the channel's offset
+    and the moment a joint sees converges to tension x offset as segments shrink. Inside its own
+    module a cable runs at ``cable_offset``; through proximal modules at ``pass_through_offset``.
+    """
+    geometry = rod.geometry
     angles = [angle for _, angle, _, _ in _CABLES]
     rings = {"outer": chain.ring_offsets(self.cable_offset, angles),
              "inner": chain.ring_offsets(self.pass_through_offset, angles)}
-    spacing = self.module_length / self.disks_per_module
-    disks = [("base", 0.0, 0)] + [
-        (f"module{module}_disk{disk}", ((module - 1) * self.disks_per_module + disk) * spacing,
-         module)
-        for module in range(1, self.num_modules + 1)
-        for disk in range(1, self.disks_per_module + 1)]
-    holes = []  # [disk][ring][cable]
-    for prefix, arc_length, module in disks:
-      holes.append({})
-      # The base and every disk of a module feed the next module's cables inwards, except the
-      # tip plate of the last module which no cable passes.
-      for ring in ("outer", "inner") if module < self.num_modules else ("outer",):
-        holes[-1][ring] = [f"{prefix}_{ring}_hole_{name}" for name, *_ in _CABLES]
-        for site, offset in zip(holes[-1][ring], rings[ring]):
-          rod.add_site(site, arc_length, offset, size=(0.0008, 0, 0), rgba=(0.2, 0.2, 0.2, 1))
+    inset = self.hole_inset * self.segment_length
+    joints = geometry.joint_arc_lengths()
+    # (body name, arc length) of every hole position, base to tip.
+    holes = [(chain.CLAMP + "_distal", joints[0] - inset)]
+    for index, joint in enumerate(joints):
+      name = rod.bodies[index + 1].name
+      holes.append((name + "_proximal", joint + inset))
+      if index + 1 < len(joints):
+        holes.append((name + "_distal", joints[index + 1] - inset))
     for module in range(1, self.num_modules + 1):
+      start, tip = geometry.module_start(module), geometry.module_start(module + 1)
       rgba = _MODULE_RGBA[(module - 1) % len(_MODULE_RGBA)]
-      own_first_disk = 1 + (module - 1) * self.disks_per_module
       for cable, (cable_name, *_) in enumerate(_CABLES):
         tendon = spec.add_tendon(name=f"module{module}_cable_{cable_name}", width=0.0005,
                                  rgba=rgba)
-        for disk, disk_holes in enumerate(holes[:1 + module * self.disks_per_module]):
-          ring = "outer" if disk >= own_first_disk or module == 1 else "inner"
-          tendon.wrap_site(disk_holes[ring][cable])
+        for prefix, arc_length in holes:
+          if arc_length >= tip:
+            break
+          ring = "outer" if arc_length >= start or module == 1 else "inner"
+          site = f"{prefix}_{ring}_hole_{cable_name}"
+          if site not in self._sites_added(spec):
+            rod.add_site(site, arc_length, rings[ring][cable], size=(0.0006, 0, 0),
+                         rgba=(0.2, 0.2, 0.2, 1))
+          tendon.wrap_site(site)
+        anchor = f"module{module}_anchor_{cable_name}"
+        rod.add_site(anchor, tip, rings["outer"][cable], size=(0.0009, 0, 0),
+                     rgba=(0.1, 0.1, 0.1, 1))
+        tendon.wrap_site(anchor)
         spec.add_actuator(
             name=f"module{module}_cable_{cable_name}",
             trntype=mujoco.mjtTrn.mjTRN_TENDON, target=tendon.name,
             gear=(-1, 0, 0, 0, 0, 0),  # Cables pull: positive control shortens the tendon.
             ctrllimited=mujoco.mjtLimited.mjLIMITED_TRUE, ctrlrange=(0, self.max_tension))
+
+  @staticmethod
+  def _sites_added(spec: mujoco.MjSpec) -> set[str]:
+    return {site.name for site in spec.sites}
