@@ -3,15 +3,12 @@
 Goal (issue 2): tendon-5 at least 10x faster than real time on one core.
 """
 
-import dataclasses
-
 import mujoco
 import numpy as np
 import pytest
 from mujoco import rollout
 
 from softbench import robots
-from softbench.robots import base
 
 _SIMULATED_SECONDS = 2.0  # (s) Simulated time per benchmark round, under random actuation.
 
@@ -24,8 +21,7 @@ def test_physics_steps_per_second(benchmark, name):
   steps_per_action = int(round(robot.control_timestep / model.opt.timestep))
   periods = max(1, int(round(_SIMULATED_SECONDS / robot.control_timestep)))
   actions = np.random.default_rng(0).uniform(-1, 1, (periods, robot.action_dim))
-  action_map = np.array([dataclasses.astuple(m) for m in robot.actuator_maps()])
-  controls = np.repeat(base.action_to_ctrl(action_map, actions), steps_per_action, axis=0)[None]
+  controls = np.repeat(robot.action_to_ctrl(actions), steps_per_action, axis=0)[None]
   state = np.empty(mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS))
   mujoco.mj_getState(model, data, state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
   benchmark(rollout.rollout, model, data, state[None], controls)

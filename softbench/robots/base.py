@@ -106,6 +106,15 @@ class SoftArm(abc.ABC):
     ends = np.cumsum(self.actuators_per_module)
     return [slice(int(end - size), int(end)) for end, size in zip(ends, self.actuators_per_module)]
 
+  def action_map(self) -> np.ndarray:
+    """(num_actuators, 4) rows of (action index, ctrl at -1, at 0, at +1), as
+    ``action_to_ctrl`` takes them."""
+    return np.array([dataclasses.astuple(m) for m in self.actuator_maps()], dtype=float)
+
+  def action_to_ctrl(self, action: np.ndarray) -> np.ndarray:
+    """Controls of every actuator for actions (..., action_dim) in [-1, 1]."""
+    return action_to_ctrl(self.action_map(), action)
+
   def refined(self, factor: int) -> "SoftArm":
     """The same robot with ``factor`` times more segments and a time step ``factor`` times
     shorter, to measure discretisation error."""
@@ -118,9 +127,7 @@ class SoftArm(abc.ABC):
     spec.modelname = self.name
     spec.compiler.degree = False
     self._build(spec)
-    rows = [[m.action_index, m.at_minus_one, m.at_zero, m.at_plus_one]
-            for m in self.actuator_maps()]
-    spec.add_numeric(name=ACTION_MAP_NAME, data=np.asarray(rows, dtype=float).ravel().tolist())
+    spec.add_numeric(name=ACTION_MAP_NAME, data=self.action_map().ravel().tolist())
     return spec
 
   def to_xml(self) -> str:

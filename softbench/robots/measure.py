@@ -4,7 +4,6 @@ Everything runs headless on the CPU with MuJoCo's own ``rollout``; all randomnes
 the seed passed in, so the same robot gives the same figures.
 """
 
-import dataclasses
 import time
 
 import mujoco
@@ -35,9 +34,8 @@ def tip_trajectory(robot: base.SoftArm, actions: np.ndarray, hold_seconds: float
   """
   model = model if model is not None else robot.compile()
   data = mujoco.MjData(model)
-  action_map = np.array([dataclasses.astuple(m) for m in robot.actuator_maps()])
   steps = int(round(hold_seconds / model.opt.timestep))
-  controls = np.repeat(base.action_to_ctrl(action_map, np.atleast_2d(actions)), steps, axis=0)
+  controls = np.repeat(robot.action_to_ctrl(np.atleast_2d(actions)), steps, axis=0)
   sites = [model.site(chain.tip_site_name(k)).id for k in range(1, robot.num_modules + 1)]
   states, _ = rollout.rollout(model, data, _state(model, data)[None], controls[None])
   if data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number or not np.all(np.isfinite(states)):
@@ -71,8 +69,7 @@ def bend_angle(robot: base.SoftArm, action: np.ndarray, module: int = 1,
   mujoco.mj_kinematics(model, data)
   site = model.site(chain.tip_site_name(module)).id
   rest_axis = data.site_xmat[site].reshape(3, 3)[:, 2].copy()
-  action_map = np.array([dataclasses.astuple(m) for m in robot.actuator_maps()])
-  data.ctrl[:] = base.action_to_ctrl(action_map, action)
+  data.ctrl[:] = robot.action_to_ctrl(action)
   mujoco.mj_step(model, data, nstep=int(round(seconds / model.opt.timestep)))
   axis = data.site_xmat[site].reshape(3, 3)[:, 2]
   return float(np.degrees(np.arccos(np.clip(axis @ rest_axis, -1.0, 1.0))))
@@ -101,9 +98,8 @@ def simulation_speed(robot: base.SoftArm, seconds: float = 5.0, seed: int = 0) -
   model = robot.compile()
   periods = max(1, int(round(seconds / robot.control_timestep)))
   actions = np.random.default_rng(seed).uniform(-1, 1, (periods, robot.action_dim))
-  action_map = np.array([dataclasses.astuple(m) for m in robot.actuator_maps()])
   steps = int(round(robot.control_timestep / model.opt.timestep))
-  controls = np.repeat(base.action_to_ctrl(action_map, actions), steps, axis=0)[None]
+  controls = np.repeat(robot.action_to_ctrl(actions), steps, axis=0)[None]
   data = mujoco.MjData(model)
   start = time.perf_counter()
   rollout.rollout(model, data, _state(model, data)[None], controls)
