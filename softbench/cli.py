@@ -32,7 +32,7 @@ def _robots(args: argparse.Namespace) -> None:
   print(_describe(robot))
   print(f"\ncontrol period: {robot.control_timestep} s; actions per module: "
         f"{', '.join(map(str, robot.actuators_per_module))}")
-  for field, value in model_export._fields(robot):
+  for field, value in model_export.spec_fields(robot):
     print(f"  {field} = {value}")
 
 

@@ -108,6 +108,24 @@ class Chain:
     index = max(index, 0)
     return self.bodies[index], arc_length - self.origins[index]
 
+  def channel_holes(self, inset_fraction: float, start: float = 0.0,
+                    end: float = math.inf) -> list[tuple[str, float]]:
+    """Where a tendon running in a channel along the rod is held, as (label, arc length) with
+    ``start <= arc length < end``: near both ends of every body, ``inset_fraction`` of a segment
+    from each joint, so the short stretch crossing a joint passes it at the channel's offset and
+    the moment the joint sees converges to tension x offset as segments shrink."""
+    joints = self.geometry.joint_arc_lengths()
+    n = self.geometry.segments_per_module
+    insets = [inset_fraction * self.geometry.segment_length(i // n + 1)
+              for i in range(len(joints))]
+    holes = [(f"{self.bodies[0].name}_distal", joints[0] - insets[0])]
+    for index in range(len(joints)):
+      name = self.bodies[index + 1].name
+      holes.append((f"{name}_proximal", joints[index] + insets[index]))
+      if index + 1 < len(joints):
+        holes.append((f"{name}_distal", joints[index + 1] - insets[index + 1]))
+    return [(label, s) for label, s in holes if start <= s < end]
+
   def add_site(self, name: str, arc_length: float, offset: Sequence[float] = (0.0, 0.0),
                **attributes) -> mujoco.MjsSite:
     """Adds a site at ``arc_length`` along the rod, ``offset`` = (local y, local z) off its axis."""

@@ -70,7 +70,7 @@ def readme(robot: base.SoftArm, speed: dict | None) -> str:
       f"{robot.name}/scene.xml`.", "",
       "## Spec", "",
       "| field | value |", "|---|---|",
-      *[f"| `{field}` | {value} |" for field, value in _fields(robot)], "",
+      *[f"| `{field}` | {value} |" for field, value in spec_fields(robot)], "",
       "## Measured", "",
       f"- Modules: {robot.num_modules}; action dimension: {robot.action_dim}; "
       f"length at rest: {robot.length * 1000:.0f} mm; moving mass: {robot.mass(model) * 1000:.1f} g; "
@@ -99,7 +99,8 @@ def readme(robot: base.SoftArm, speed: dict | None) -> str:
   return "\n".join(lines) + "\n"
 
 
-def _fields(robot: base.SoftArm):
+def spec_fields(robot: base.SoftArm):
+  """(field, printable value) of every field of the robot's spec."""
   for field in robot.__dataclass_fields__:
     value = getattr(robot, field)
     yield field, (f"{value:g}" if isinstance(value, float) else value)

@@ -195,33 +195,21 @@ class TendonArm(base.SoftArm):
     """Routes four cables per module along the rod to the module's tip, where each is anchored,
     and gives each cable a pulling motor.
 
-    A cable runs in a channel: every segment holds it at two holes, ``hole_inset`` of a segment
-    from either joint, so the short stretch crossing a joint passes it at the channel's offset
-    and the moment a joint sees converges to tension x offset as segments shrink. Inside its own
-    module a cable runs at ``cable_offset``; through proximal modules at ``pass_through_offset``.
+    A cable runs in a channel, held near both ends of every segment (``Chain.channel_holes``).
+    Inside its own module a cable runs at ``cable_offset``; through proximal modules at
+    ``pass_through_offset``.
     """
     geometry = rod.geometry
     angles = [angle for _, angle, _, _ in _CABLES]
     rings = {"outer": chain.ring_offsets(self.cable_offset, angles),
              "inner": chain.ring_offsets(self.pass_through_offset, angles)}
-    inset = self.hole_inset * self.segment_length
-    joints = geometry.joint_arc_lengths()
-    # (body name, arc length) of every hole position, base to tip.
-    holes = [(chain.CLAMP + "_distal", joints[0] - inset)]
-    for index, joint in enumerate(joints):
-      name = rod.bodies[index + 1].name
-      holes.append((name + "_proximal", joint + inset))
-      if index + 1 < len(joints):
-        holes.append((name + "_distal", joints[index + 1] - inset))
     for module in range(1, self.num_modules + 1):
       start, tip = geometry.module_start(module), geometry.module_start(module + 1)
       rgba = _MODULE_RGBA[(module - 1) % len(_MODULE_RGBA)]
       for cable, (cable_name, *_) in enumerate(_CABLES):
         tendon = spec.add_tendon(name=f"module{module}_cable_{cable_name}", width=0.0005,
                                  rgba=rgba)
-        for prefix, arc_length in holes:
-          if arc_length >= tip:
-            break
+        for prefix, arc_length in rod.channel_holes(self.hole_inset, end=tip):
           ring = "outer" if arc_length >= start or module == 1 else "inner"
           site = f"{prefix}_{ring}_hole_{cable_name}"
           if site not in self._sites_added(spec):
