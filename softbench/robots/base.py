@@ -136,7 +136,9 @@ class SoftArm(abc.ABC):
     return spec.to_xml()
 
   def compile(self) -> mujoco.MjModel:
-    return self.build_spec().compile()
+    """The model exactly as its exported MJCF loads (the XML rounds numbers to 6 digits, so
+    compiling the spec directly would give a slightly different model)."""
+    return mujoco.MjModel.from_xml_string(self.to_xml())
 
   def mass(self, model: mujoco.MjModel | None = None) -> float:
     """Total mass of the moving arm (kg)."""

@@ -44,7 +44,7 @@ class TendonArm(base.SoftArm):
     segments_per_module: Rigid segments per module (discretisation of the rod).
     hole_inset: Distance of a cable hole from the nearest joint, as a fraction of the segment
       length. The holes on the concave side of a joint meet when it bends by
-      2·atan(hole_inset · segment length / cable_offset), 23 degrees per joint or about 113
+      2·atan(hole_inset · segment length / cable_offset), 16 degrees per joint or about 114
       degrees per module by default: a bending limit, like spacer disks touching, that holds at
       every discretisation because the inset scales with the segment.
     radius: Backbone radius (m).
@@ -69,7 +69,7 @@ class TendonArm(base.SoftArm):
 
   num_modules: int = 3
   module_length: float = MODULE_LENGTH
-  segments_per_module: int = 5
+  segments_per_module: int = 7
   hole_inset: float = 0.12
   radius: float = 0.005
   youngs_modulus: float = 1.0e6
@@ -77,12 +77,12 @@ class TendonArm(base.SoftArm):
   density: float = 1100.0
   cable_offset: float = 0.006
   pass_through_offset: float = 0.002
-  max_tension: float = 2.56  # Bends tendon-1 by 90.0 deg (bisection on measure.bend_angle).
+  max_tension: float = 2.58  # Bends tendon-1 by 89.9 deg (bisection on measure.bend_angle).
   damping: float = 2.0e-3
   medium_viscosity: float = 0.1
-  armature: float = 1.0e-6
+  armature: float = 1.0e-5
   backbone: str = "cable"
-  timestep: float = 2.0e-3
+  timestep: float = 4.0e-3
   control_period: float = 1.0
 
   def __post_init__(self):
