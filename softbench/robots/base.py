@@ -14,7 +14,6 @@ import mujoco
 import numpy as np
 
 ACTION_MAP_NAME = "action_map"
-GRAVITY = 9.81  # (m/s²)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -143,7 +142,8 @@ class SoftArm(abc.ABC):
   def mass(self, model: mujoco.MjModel | None = None) -> float:
     """Total mass of the moving arm (kg)."""
     model = model if model is not None else self.compile()
-    return float(model.body_subtreemass[model.body("base").id] - model.body_mass[model.body("base").id])
+    base_body = model.body("base").id
+    return float(model.body_subtreemass[base_body] - model.body_mass[base_body])
 
 
 def check_positive(name: str, value: float) -> None:

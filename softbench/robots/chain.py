@@ -89,6 +89,11 @@ def segment_name(module: int, segment: int) -> str:
   return f"module{module}_segment{segment}"
 
 
+def module_rgba(palette: Sequence[Sequence[float]], module: int) -> Sequence[float]:
+  """The colour of module ``module`` (1-based), cycling through ``palette``."""
+  return palette[(module - 1) % len(palette)]
+
+
 def tip_site_name(module: int) -> str:
   return f"module{module}_tip"
 
@@ -163,7 +168,7 @@ def add_chain(
     name = segment_name(module, segment)
     body = body.add_body(name=name, pos=(start - origins[-1], 0, 0))
     _add_joints(body, name, joints, start - origins[-1])
-    _add_rod_geom(body, f"{name}_geom", 0.0, end - start, geometry, rgba[module - 1])
+    _add_rod_geom(body, f"{name}_geom", 0.0, end - start, geometry, module_rgba(rgba, module))
     if cable_plugin is not None:
       body.plugin = cable_plugin
     bodies.append(body)

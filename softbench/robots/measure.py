@@ -78,9 +78,10 @@ def bend_angle(robot: base.SoftArm, action: np.ndarray, module: int = 1,
 def settling_time(robot: base.SoftArm, seconds: float = SETTLE_SECONDS) -> float:
   """Seconds until the end effector stays within ``SETTLED_TOLERANCE`` of its final position
   after a step from rest to full actuation of module 1."""
-  tips = tip_trajectory(robot, full_bend_action(robot, 1), seconds)[:, -1]
+  model = robot.compile()
+  tips = tip_trajectory(robot, full_bend_action(robot, 1), seconds, model)[:, -1]
   moving = np.flatnonzero(np.linalg.norm(tips - tips[-1], axis=1) > SETTLED_TOLERANCE)
-  return 0.0 if len(moving) == 0 else float((moving[-1] + 1) * robot.compile().opt.timestep)
+  return 0.0 if len(moving) == 0 else float((moving[-1] + 1) * model.opt.timestep)
 
 
 def workspace_extent(robot: base.SoftArm, seed: int = 0,
@@ -88,8 +89,9 @@ def workspace_extent(robot: base.SoftArm, seed: int = 0,
   """(3, 2) min and max (m) of the end effector over random actions, each held one control
   period, recorded at the end of every period as in motor babbling."""
   actions = np.random.default_rng(seed).uniform(-1, 1, (samples, robot.action_dim))
-  steps = int(round(robot.control_timestep / robot.compile().opt.timestep))
-  tips = tip_trajectory(robot, actions, robot.control_timestep)[steps - 1::steps, -1]
+  model = robot.compile()
+  steps = int(round(robot.control_timestep / model.opt.timestep))
+  tips = tip_trajectory(robot, actions, robot.control_timestep, model)[steps - 1::steps, -1]
   return np.stack([tips.min(axis=0), tips.max(axis=0)], axis=1)
 
 

@@ -166,7 +166,7 @@ class PneumaticArm(base.SoftArm):
       start = rod.geometry.module_start(module)
       spacing = rod.geometry.segment_length(module)
       offsets = chain.ring_offsets(self.bellows_offset, self.bellows_angles(module))
-      rgba = _MODULE_RGBA[module - 1]
+      rgba = chain.module_rgba(_MODULE_RGBA, module)
       for bellows, offset in enumerate(offsets, start=1):
         name = f"module{module}_bellows{bellows}"
         tendon = spec.add_tendon(name=name, width=self.bellows_radius * 0.5,

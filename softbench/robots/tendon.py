@@ -182,13 +182,13 @@ class TendonArm(base.SoftArm):
     else:
       plugin = None
       joint_bending_stiffness = self.bending_stiffness
-    joints = chain.SegmentJoints(bending_stiffness=joint_bending_stiffness, ball_damping=self.damping,
-                                 armature=self.armature)
+    joints = chain.SegmentJoints(bending_stiffness=joint_bending_stiffness,
+                                 ball_damping=self.damping, armature=self.armature)
     base_body = spec.worldbody.add_body(name="base")
     base_body.add_geom(name="base_plate", type=mujoco.mjtGeom.mjGEOM_CYLINDER,
                        size=(self.cable_offset * 2, 0.002, 0), pos=(0, 0, 0.002),
                        rgba=(0.3, 0.3, 0.3, 1), contype=0, conaffinity=0)
-    rod = chain.add_chain(base_body, geometry, joints, _MODULE_RGBA * 2, plugin)
+    rod = chain.add_chain(base_body, geometry, joints, _MODULE_RGBA, plugin)
     self._add_cables(spec, rod)
 
   def _add_cables(self, spec: mujoco.MjSpec, rod: chain.Chain) -> None:
@@ -203,16 +203,18 @@ class TendonArm(base.SoftArm):
     angles = [angle for _, angle, _, _ in _CABLES]
     rings = {"outer": chain.ring_offsets(self.cable_offset, angles),
              "inner": chain.ring_offsets(self.pass_through_offset, angles)}
+    added = set()  # Holes are shared by every cable that passes them.
     for module in range(1, self.num_modules + 1):
       start, tip = geometry.module_start(module), geometry.module_start(module + 1)
-      rgba = _MODULE_RGBA[(module - 1) % len(_MODULE_RGBA)]
+      rgba = chain.module_rgba(_MODULE_RGBA, module)
       for cable, (cable_name, *_) in enumerate(_CABLES):
         tendon = spec.add_tendon(name=f"module{module}_cable_{cable_name}", width=0.0005,
                                  rgba=rgba)
         for prefix, arc_length in rod.channel_holes(self.hole_inset, end=tip):
           ring = "outer" if arc_length >= start or module == 1 else "inner"
           site = f"{prefix}_{ring}_hole_{cable_name}"
-          if site not in self._sites_added(spec):
+          if site not in added:
+            added.add(site)
             rod.add_site(site, arc_length, rings[ring][cable], size=(0.0006, 0, 0),
                          rgba=(0.2, 0.2, 0.2, 1))
           tendon.wrap_site(site)
@@ -225,7 +227,3 @@ class TendonArm(base.SoftArm):
             trntype=mujoco.mjtTrn.mjTRN_TENDON, target=tendon.name,
             gear=(-1, 0, 0, 0, 0, 0),  # Cables pull: positive control shortens the tendon.
             ctrllimited=mujoco.mjtLimited.mjLIMITED_TRUE, ctrlrange=(0, self.max_tension))
-
-  @staticmethod
-  def _sites_added(spec: mujoco.MjSpec) -> set[str]:
-    return {site.name for site in spec.sites}
