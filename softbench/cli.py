@@ -5,10 +5,13 @@ import argparse
 import pathlib
 import sys
 
+from softbench import data
 from softbench import robots
+from softbench import suite
 from softbench.robots import export as model_export
 
 EXIT_USAGE = 2
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it.
 
 
 def _robot_overrides(args: argparse.Namespace) -> dict:
@@ -43,6 +46,27 @@ def _models_export(args: argparse.Namespace) -> None:
       print(path)
 
 
+def _tasks(args: argparse.Namespace) -> None:
+  print(f"{'task':<10} {'tags':<24} description")
+  for task in suite.TASKS:
+    entry = suite.describe(task)
+    print(f"{task:<10} {', '.join(entry.tags):<24} {entry.description}")
+  periods = sorted({(robots.make(name).control_timestep, name.split("-")[0])
+                    for name in robots.BENCHMARK_ROBOTS}, key=lambda item: item[1])
+  print("\ncontrol period: " + "; ".join(f"{family} arms {period:g} s ({1 / period:g} Hz)"
+                                         for period, family in periods))
+  print(f"{len(suite.ALL_TASKS)} (robot, task) pairs on the benchmark robots "
+        f"({', '.join(robots.BENCHMARK_ROBOTS)}); every task runs on any robot")
+
+
+def _collect(args: argparse.Namespace) -> None:
+  dataset = data.collect(args.robot, samples=args.samples, seed=args.seed, workers=args.workers)
+  seconds = dataset.collection.get("wall_time_s")
+  print(f"{dataset.robot_name}: {dataset.samples} samples in {dataset.num_episodes} episodes"
+        + (f" (collection took {seconds:.1f} s)" if seconds is not None else ""))
+  print(dataset.path)
+
+
 def build_parser() -> argparse.ArgumentParser:
   parser = argparse.ArgumentParser(prog="softbench", description=__doc__.split(".")[0] + ".")
   commands = parser.add_subparsers(dest="command", required=True)
@@ -50,6 +74,19 @@ def build_parser() -> argparse.ArgumentParser:
   robots_parser.add_argument("name", nargs="?", help="e.g. tendon-3 or pneumatic-433")
   robots_parser.add_argument("--module-length", type=float, help="module length in m")
   robots_parser.set_defaults(run=_robots)
+  tasks_parser = commands.add_parser("tasks", help="list the tasks of the suite")
+  tasks_parser.set_defaults(run=_tasks)
+  collect_parser = commands.add_parser(
+      "collect", help="record (or resume) a motor-babbling dataset",
+      description="Motor babbling with every module active, cached under $SOFTBENCH_HOME "
+                  "(default ~/.cache/softbench); an interrupted collection resumes.")
+  collect_parser.add_argument("--robot", required=True, help="e.g. tendon-3 or pneumatic-433")
+  collect_parser.add_argument("--samples", type=int, default=data.DEFAULT_SAMPLES,
+                              help=f"control periods to record (default {data.DEFAULT_SAMPLES})")
+  collect_parser.add_argument("--seed", type=int, default=0, help="seed of the random actions")
+  collect_parser.add_argument("--workers", type=int, default=None,
+                              help="simulation threads (default: every core)")
+  collect_parser.set_defaults(run=_collect)
   models = commands.add_parser("models", help="exported MJCF models")
   models_commands = models.add_subparsers(dest="models_command", required=True)
   export_parser = models_commands.add_parser("export", help="write models/<name>/ for every robot")
@@ -64,9 +101,12 @@ def main(argv: list[str] | None = None) -> int:
   args = build_parser().parse_args(argv)
   try:
     args.run(args)
-  except (ValueError, FileNotFoundError) as error:
+  except (ValueError, FileNotFoundError, FloatingPointError) as error:
     print(f"softbench: error: {error}", file=sys.stderr)
     return EXIT_USAGE
+  except KeyboardInterrupt:
+    print("softbench: interrupted; run the same command again to resume", file=sys.stderr)
+    return EXIT_INTERRUPTED
   return 0
 
 

@@ -8,6 +8,7 @@ import pytest
 
 from softbench import cli
 from softbench import robots
+from softbench import suite
 from softbench.robots import export
 
 MODELS = pathlib.Path(__file__).resolve().parents[1] / "models"
@@ -66,3 +67,39 @@ def test_cli_refuses_bad_input_with_one_line_and_exit_code_2(argv, capsys):
   assert len(lines) == 1 and lines[0].startswith("softbench: error: ")
   with pytest.raises(ValueError, match=lines[0].removeprefix("softbench: error: ")[:20]):
     robots.make(argv[1], **({"module_length": -0.05} if len(argv) > 2 else {}))
+
+
+def test_cli_lists_every_task_and_the_control_periods(capsys):
+  assert cli.main(["tasks"]) == 0
+  out = capsys.readouterr().out
+  for task in suite.TASKS:
+    assert f"\n{task} " in out
+  assert "tendon arms 1 s (1 Hz)" in out and "pneumatic arms 0.2 s (5 Hz)" in out
+
+
+def test_cli_collects_a_dataset_then_finds_it(tmp_path, monkeypatch, capsys):
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
+  argv = ["collect", "--robot", "tendon-1", "--samples", "20", "--seed", "3", "--workers", "1"]
+  assert cli.main(argv) == 0
+  first = capsys.readouterr().out.splitlines()
+  assert first[0].startswith("tendon-1: 20 samples in 1 episodes")
+  folder = pathlib.Path(first[1])
+  assert (folder / "dataset.npz").exists() and folder.is_relative_to(tmp_path)
+  before = (folder / "dataset.npz").read_bytes()
+  assert cli.main(argv) == 0
+  assert capsys.readouterr().out.splitlines()[1] == first[1]
+  assert (folder / "dataset.npz").read_bytes() == before
+
+
+@pytest.mark.parametrize("argv", [
+    ["collect", "--robot", "tendon-0"], ["collect", "--robot", "unicorn"],
+    ["collect", "--robot", "tendon-2", "--samples", "0"],
+    ["collect", "--robot", "tendon-2", "--seed", "-1"],
+    ["collect", "--robot", "tendon-2", "--workers", "0"],
+])
+def test_cli_collect_refuses_bad_input(argv, capsys, tmp_path, monkeypatch):
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
+  assert cli.main(argv) == cli.EXIT_USAGE
+  lines = capsys.readouterr().err.strip().splitlines()
+  assert len(lines) == 1 and lines[0].startswith("softbench: error: ")
+  assert not (tmp_path / "datasets").exists()

@@ -82,6 +82,11 @@ class SoftArm(abc.ABC):
   def bend_action_pattern(self, module: int) -> np.ndarray:
     """The module's own action entries that bend it fully towards world +x."""
 
+  @abc.abstractmethod
+  def bend_basis(self, module: int) -> np.ndarray:
+    """(2, entries) the module's own action entries per unit of bending towards world +x (row
+    0) and +y (row 1); ``planar_action`` combines them linearly."""
+
   @property
   @abc.abstractmethod
   def mirror_matrix(self) -> np.ndarray:
@@ -104,6 +109,14 @@ class SoftArm(abc.ABC):
     """The slice of the action vector that belongs to each module."""
     ends = np.cumsum(self.actuators_per_module)
     return [slice(int(end - size), int(end)) for end, size in zip(ends, self.actuators_per_module)]
+
+  def planar_action(self, points: np.ndarray) -> np.ndarray:
+    """Actions (..., action_dim) that bend every module alike towards the planar actuation
+    points (..., 2), i.e. ``x * bend_basis[0] + y * bend_basis[1]``, clipped to [-1, 1]."""
+    points = np.asarray(points, dtype=float)
+    action = np.concatenate([points @ self.bend_basis(k) for k in range(1, self.num_modules + 1)],
+                            axis=-1)
+    return np.clip(action, -1.0, 1.0)
 
   def action_map(self) -> np.ndarray:
     """(num_actuators, 4) rows of (action index, ctrl at -1, at 0, at +1), as

@@ -7,15 +7,14 @@ depends on the machine, so it is measured only when asked (``--measure-speed``) 
 """
 
 import json
-import os
 import pathlib
 import platform
 import sys
-import tempfile
 
 import numpy as np
 
 from softbench.robots import base
+from softbench.storage import write_atomically
 from softbench.robots import measure
 
 SPEED_FILE = "speed.json"
@@ -38,14 +37,6 @@ _SCENE = """<mujoco model="{name} scene">
   </worldbody>
 </mujoco>
 """
-
-
-def write_atomically(path: pathlib.Path, text: str) -> None:
-  """Writes ``text`` to ``path`` through a temporary file and a rename."""
-  path.parent.mkdir(parents=True, exist_ok=True)
-  with tempfile.NamedTemporaryFile("w", dir=path.parent, delete=False, suffix=".tmp") as f:
-    f.write(text)
-  os.replace(f.name, path)
 
 
 def measure_speed(robot: base.SoftArm) -> dict:

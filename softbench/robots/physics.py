@@ -4,6 +4,7 @@ Everything it needs comes from the MJCF itself (tip sites ``module{k}_tip`` and 
 ``action_map`` numeric), so it drives an exported model file as well as a freshly built robot.
 """
 
+import mujoco as mj
 import numpy as np
 from dm_control import mujoco
 
@@ -12,7 +13,14 @@ from softbench.robots import chain
 
 
 class SoftArmPhysics(mujoco.Physics):
-  """Physics with per-module pose accessors and the robot's action map."""
+  """Physics with per-module pose accessors and the robot's action map.
+
+  ``step(n)`` is exactly ``mj_step(model, data, n)`` (as ``PoseRecorder`` runs it, so replaying
+  a recorded action sequence reproduces its poses bit for bit), followed by ``mj_kinematics`` so
+  that the pose accessors read the state after the step.
+  """
+
+  legacy_step = False
 
   @classmethod
   def from_robot(cls, robot: base.SoftArm) -> "SoftArmPhysics":
@@ -46,6 +54,10 @@ class SoftArmPhysics(mujoco.Physics):
     if np.any(np.abs(action) > 1.0 + 1e-9):
       raise ValueError(f"action entries must lie in [-1, 1], got {action.tolist()}")
     self.data.ctrl[:] = base.action_to_ctrl(self.action_map, np.clip(action, -1.0, 1.0))
+
+  def step(self, nstep: int = 1) -> None:
+    super().step(nstep)
+    mj.mj_kinematics(self.model.ptr, self.data.ptr)
 
   def module_tip_position(self, module: int) -> np.ndarray:
     """World position (m) of module ``module``'s tip (1-based)."""

@@ -137,6 +137,11 @@ class PneumaticArm(base.SoftArm):
     cosines = np.cos(np.deg2rad(self.bellows_angles(module)))
     return -np.sign(np.round(cosines, 9))
 
+  def bend_basis(self, module: int) -> np.ndarray:
+    # Bending towards a direction empties the bellows on that side and fills the opposite ones.
+    angles = np.deg2rad(self.bellows_angles(module))
+    return -np.stack([np.cos(angles), np.sin(angles)])
+
   def _build(self, spec: mujoco.MjSpec) -> None:
     spec.option.timestep = self.timestep
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST

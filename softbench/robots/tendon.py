@@ -161,6 +161,9 @@ class TendonArm(base.SoftArm):
   def bend_action_pattern(self, module: int) -> np.ndarray:
     return np.array([1.0, 0.0])  # Pull the +x cable with Tmax.
 
+  def bend_basis(self, module: int) -> np.ndarray:
+    return np.eye(2)  # Action entry 0 pulls the +x cable, entry 1 the +y cable.
+
   def _build(self, spec: mujoco.MjSpec) -> None:
     spec.option.timestep = self.timestep
     spec.option.viscosity = self.medium_viscosity

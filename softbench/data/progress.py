@@ -1,0 +1,44 @@
+"""A rich progress bar of samples collected: done / total, samples per second, time left."""
+
+from rich import console as rich_console
+from rich import progress as rich_progress
+from rich import text
+
+
+class _RateColumn(rich_progress.ProgressColumn):
+  """Samples per second, averaged by rich over the last 30 s."""
+
+  def render(self, task: rich_progress.Task) -> text.Text:
+    speed = task.finished_speed or task.speed
+    return text.Text("? samples/s" if speed is None else f"{speed:.1f} samples/s")
+
+
+class SampleProgress:
+  """A progress bar on stderr, or nothing at all when ``enabled`` is False.
+
+  with SampleProgress("tendon-3", total=14000) as bar:
+    bar.update(completed)
+  """
+
+  def __init__(self, description: str, total: int, completed: int = 0, enabled: bool = True):
+    self._progress = rich_progress.Progress(
+        rich_progress.TextColumn("{task.description}"),
+        rich_progress.BarColumn(),
+        rich_progress.MofNCompleteColumn(),
+        _RateColumn(),
+        rich_progress.TimeElapsedColumn(),
+        rich_progress.TextColumn("ETA"),
+        rich_progress.TimeRemainingColumn(),
+        console=rich_console.Console(stderr=True),
+        disable=not enabled)
+    self._task = self._progress.add_task(description, total=total, completed=completed)
+
+  def __enter__(self) -> "SampleProgress":
+    self._progress.start()
+    return self
+
+  def __exit__(self, *exception) -> None:
+    self._progress.stop()
+
+  def update(self, completed: int) -> None:
+    self._progress.update(self._task, completed=completed)

@@ -1,0 +1,110 @@
+"""Drives a robot with action sequences and records every module's pose after each control step.
+
+One recorder serves motor babbling, reference trajectories and replay checks. Episodes run side
+by side on MuJoCo's ``rollout`` thread pool, one control period per call, so that every episode
+advances in step with the others and a long recording can be saved and resumed between periods.
+The arms have no constraints (``nefc`` is 0), so chaining ``rollout`` calls through the full
+physics state reproduces uninterrupted stepping bit for bit (``mj_step`` with the same controls).
+"""
+
+from typing import Callable
+
+import mujoco
+import numpy as np
+from mujoco import rollout
+
+from softbench.robots import base
+from softbench.robots import chain
+
+POSE_SIZE = 6  # Tip position (m) and unit orientation vector of one module.
+STATE_SPEC = mujoco.mjtState.mjSTATE_FULLPHYSICS
+
+
+class PoseRecorder:
+  """Records module poses of ``robot`` under held actions, on ``workers`` threads."""
+
+  def __init__(self, robot: base.SoftArm, workers: int = 1):
+    if workers < 1:
+      raise ValueError(f"workers must be at least 1, got {workers}")
+    self.robot = robot
+    self.workers = workers
+    self.model = robot.compile()
+    self.steps_per_action = int(round(robot.control_timestep / self.model.opt.timestep))
+    # The map as stored in the MJCF, exactly as SoftArmPhysics.set_action reads it.
+    self._action_map = self.model.numeric(base.ACTION_MAP_NAME).data.reshape(-1, 4).copy()
+    self._data = [mujoco.MjData(self.model) for _ in range(workers)]
+    self._scratch = mujoco.MjData(self.model)
+    self._sites = [self.model.site(chain.tip_site_name(k)).id
+                   for k in range(1, robot.num_modules + 1)]
+
+  @property
+  def state_size(self) -> int:
+    return mujoco.mj_stateSize(self.model, STATE_SPEC)
+
+  def rest_state(self) -> np.ndarray:
+    """Full physics state of the arm at rest (reference configuration, zero velocity)."""
+    data = mujoco.MjData(self.model)
+    state = np.empty(self.state_size)
+    mujoco.mj_getState(self.model, data, state, STATE_SPEC)
+    return state
+
+  def poses(self, states: np.ndarray) -> np.ndarray:
+    """(..., num_modules, 6) module poses of full physics states (..., state_size)."""
+    states = np.asarray(states, dtype=float)
+    flat = states.reshape(-1, self.state_size)
+    poses = np.empty((len(flat), len(self._sites), POSE_SIZE))
+    for index, state in enumerate(flat):
+      mujoco.mj_setState(self.model, self._scratch, state, STATE_SPEC)
+      mujoco.mj_kinematics(self.model, self._scratch)
+      poses[index, :, :3] = self._scratch.site_xpos[self._sites]
+      poses[index, :, 3:] = self._scratch.site_xmat[self._sites].reshape(-1, 3, 3)[:, :, 2]
+    return poses.reshape(states.shape[:-1] + poses.shape[1:])
+
+  def _check_stable(self, states: np.ndarray, step: int) -> None:
+    # MuJoCo resets a diverging simulation to the rest state and counts a warning.
+    diverged = any(data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number for data in self._data)
+    if diverged or not np.all(np.isfinite(states)):
+      raise FloatingPointError(f"{self.robot.name}: simulation unstable at control step {step}")
+
+  def record(self, actions: np.ndarray, initial_states: np.ndarray | None = None,
+             on_step: Callable[[int], None] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Holds each action for one control period, episode by episode in parallel.
+
+    Args:
+      actions: (episodes, steps, action_dim) in [-1, 1].
+      initial_states: (episodes, state_size) full physics states; the rest state if None.
+      on_step: called with the number of episodes after each control period (for progress).
+
+    Returns:
+      poses: (episodes, steps + 1, num_modules, 6), the initial poses first.
+      final_states: (episodes, state_size), from which a later call continues exactly.
+
+    Raises:
+      ValueError: actions of the wrong shape or outside [-1, 1].
+      FloatingPointError: the simulation of an episode became unstable.
+    """
+    actions = np.asarray(actions, dtype=float)
+    if actions.ndim != 3 or actions.shape[2] != self.robot.action_dim:
+      raise ValueError(f"actions must be (episodes, steps, {self.robot.action_dim}), "
+                       f"got {actions.shape}")
+    if not np.all(np.isfinite(actions)) or np.any(np.abs(actions) > 1.0):
+      raise ValueError("actions must be finite and lie in [-1, 1]")
+    episodes, steps = actions.shape[:2]
+    if initial_states is None:
+      states = np.tile(self.rest_state(), (episodes, 1))
+    else:
+      states = np.array(initial_states, dtype=float).reshape(episodes, self.state_size)
+    controls = base.action_to_ctrl(self._action_map, actions)
+    poses = np.empty((episodes, steps + 1, len(self._sites), POSE_SIZE))
+    poses[:, 0] = self.poses(states)
+    buffer = np.empty((episodes, self.steps_per_action, self.state_size))
+    with rollout.Rollout(nthread=self.workers) as runner:
+      for step in range(steps):
+        runner.rollout([self.model] * episodes, self._data, states, controls[:, step, None],
+                       nstep=self.steps_per_action, state=buffer)
+        states = buffer[:, -1].copy()
+        self._check_stable(states, step)
+        poses[:, step + 1] = self.poses(states)
+        if on_step is not None:
+          on_step(episodes)
+    return poses, states

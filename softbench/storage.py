@@ -1,0 +1,53 @@
+"""Where softbench keeps its files, and how it writes them: atomically, with content hashes.
+
+The data home is ``$SOFTBENCH_HOME`` if set, else ``$XDG_CACHE_HOME/softbench`` (by default
+``~/.cache/softbench``). Every file goes through a temporary file in the same folder and an
+``os.replace``, so a reader sees the old file or the new one, never half of one.
+"""
+
+import hashlib
+import io
+import os
+import pathlib
+import tempfile
+
+import numpy as np
+
+HOME_VARIABLE = "SOFTBENCH_HOME"
+
+
+def softbench_home() -> pathlib.Path:
+  """The folder under which datasets, reference trajectories and checkpoints are cached."""
+  if os.environ.get(HOME_VARIABLE):
+    return pathlib.Path(os.environ[HOME_VARIABLE]).expanduser()
+  cache = os.environ.get("XDG_CACHE_HOME") or pathlib.Path.home() / ".cache"
+  return pathlib.Path(cache) / "softbench"
+
+
+def write_atomically(path: pathlib.Path, content: str | bytes) -> None:
+  """Writes ``content`` (text or bytes) to ``path`` through a temporary file and a rename."""
+  path = pathlib.Path(path)
+  path.parent.mkdir(parents=True, exist_ok=True)
+  mode = "wb" if isinstance(content, bytes) else "w"
+  with tempfile.NamedTemporaryFile(mode, dir=path.parent, delete=False, suffix=".tmp") as f:
+    f.write(content)
+    f.flush()
+    os.fsync(f.fileno())
+  os.replace(f.name, path)
+
+
+def arrays_sha256(arrays: dict[str, np.ndarray]) -> str:
+  """A hash of named arrays' names, dtypes, shapes and bytes, independent of the file format."""
+  digest = hashlib.sha256()
+  for name in sorted(arrays):
+    array = np.ascontiguousarray(arrays[name])
+    digest.update(f"{name}|{array.dtype.str}|{array.shape}|".encode())
+    digest.update(array.tobytes())
+  return digest.hexdigest()
+
+
+def npz_bytes(arrays: dict[str, np.ndarray]) -> bytes:
+  """The bytes of an uncompressed ``.npz`` of ``arrays``; the same arrays give the same bytes."""
+  buffer = io.BytesIO()
+  np.savez(buffer, **{name: arrays[name] for name in sorted(arrays)})
+  return buffer.getvalue()

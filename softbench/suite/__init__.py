@@ -1,0 +1,104 @@
+"""The softbench task suite, in the style of ``dm_control.suite``.
+
+``load(robot, task, seed)`` returns a ``dm_control.rl.control.Environment``. Every task exists
+for every robot; ``ALL_TASKS`` lists the (robot, task) pairs of the benchmark robots and
+``BENCHMARKING`` those the leaderboard scores. ``custom`` follows a user's trajectory
+(``trajectory=ARRAY_OR_PATH``) and is in neither list, as it needs one.
+
+One control step lasts the robot's control period (``robot.control_timestep``): 1 s for the
+tendon arms (1 Hz, the paper's simulator; tendon-5, the slowest, settles in 0.72 s) and 0.2 s
+for the pneumatic arm (5 Hz, as on the real robot).
+"""
+
+import collections
+import inspect
+from typing import Callable
+
+from dm_control.rl import control
+
+from softbench import robots
+from softbench.robots import physics as arm_physics
+from softbench.suite import base
+from softbench.suite import reach
+from softbench.suite import references
+from softbench.suite import tracking
+from softbench.suite import trajectories
+
+TaskEntry = collections.namedtuple("TaskEntry", ["build", "tags", "description"])
+
+
+def _reference_task(shape: str) -> Callable[..., base.SoftArmTask]:
+  def build(robot, length: int = references.REFERENCE_LENGTH,
+            initial_actuation: float = base.INITIAL_ACTUATION, random=None) -> base.SoftArmTask:
+    return tracking.Tracking(robot, references.reference(robot, shape, length).targets,
+                             initial_actuation=initial_actuation, random=random)
+  return build
+
+
+def _custom_task(robot, trajectory=None, initial_actuation: float = base.INITIAL_ACTUATION,
+                 random=None) -> base.SoftArmTask:
+  if trajectory is None:
+    raise ValueError("task 'custom' needs a trajectory (trajectory=ARRAY_OR_PATH, or "
+                     "--trajectory FILE)")
+  return tracking.Tracking(robot, trajectories.load_trajectory(trajectory, robot),
+                           initial_actuation=initial_actuation, random=random)
+
+
+_TASKS = {
+    "babbling": TaskEntry(_reference_task("babbling"), ("benchmarking", "tracking"),
+                          "follow held-out poses produced by random actuation"),
+    "circle": TaskEntry(_reference_task("circle"), ("benchmarking", "tracking"),
+                        "follow a circle traced in actuation space"),
+    "rectangle": TaskEntry(_reference_task("rectangle"), ("benchmarking", "tracking"),
+                           "follow a rectangle traced in actuation space"),
+    "spiral": TaskEntry(_reference_task("spiral"), ("benchmarking", "tracking"),
+                        "follow a growing spiral traced in actuation space"),
+    "reach": TaskEntry(reach.Reach, ("benchmarking",),
+                       "bring one module's tip to a virtual point (position only)"),
+    "custom": TaskEntry(_custom_task, ("tracking", "user"),
+                        "follow your own trajectory (.npy or .csv, one target per row)"),
+}
+TASKS = tuple(_TASKS)
+ALL_TASKS = tuple((robot, task) for robot in robots.BENCHMARK_ROBOTS for task in TASKS
+                  if "user" not in _TASKS[task].tags)
+BENCHMARKING = tuple((robot, task) for robot, task in ALL_TASKS
+                     if "benchmarking" in _TASKS[task].tags)
+
+
+def describe(task: str) -> TaskEntry:
+  if task not in _TASKS:
+    raise ValueError(f"unknown task {task!r}; choose one of {', '.join(TASKS)}")
+  return _TASKS[task]
+
+
+def load(robot: str | robots.SoftArm, task: str, seed=None, environment_kwargs: dict | None = None,
+         **task_kwargs) -> control.Environment:
+  """The environment of ``task`` on ``robot`` (a name such as ``tendon-3``, or a robot spec).
+
+  Args:
+    robot: robot name or ``SoftArm`` instance.
+    task: one of ``TASKS``.
+    seed: seed of the task's random start (an int, a ``numpy.random.RandomState`` or None).
+    environment_kwargs: extra keyword arguments of ``control.Environment``.
+    **task_kwargs: the task's options, e.g. ``length`` (tracking), ``module`` and ``steps``
+      (reach), ``trajectory`` (custom), ``initial_actuation`` (all).
+
+  Raises:
+    ValueError: unknown robot or task, or an invalid task option (one line).
+  """
+  entry = describe(task)
+  arm = robots.make(robot) if isinstance(robot, str) else robot
+  if not isinstance(arm, robots.SoftArm):
+    raise ValueError(f"robot must be a name or a SoftArm, got {robot!r}")
+  options = set(inspect.signature(entry.build).parameters) - {"robot", "random"}
+  unknown = sorted(set(task_kwargs) - options)
+  if unknown:
+    raise ValueError(f"task {task!r} has no option {unknown[0]!r}; its options: "
+                     f"{', '.join(sorted(options))}")
+  built = entry.build(arm, random=seed, **task_kwargs)
+  physics = arm_physics.SoftArmPhysics.from_robot(arm)
+  return control.Environment(physics, built, control_timestep=arm.control_timestep,
+                             **(environment_kwargs or {}))
+
+
+__all__ = ["ALL_TASKS", "BENCHMARKING", "TASKS", "describe", "load"]

@@ -1,0 +1,107 @@
+"""What every softbench task shares: actions in [-1, 1], a randomised start, pose observations
+and a reward in [0, 1] from ``dm_control.utils.rewards.tolerance`` on position error.
+
+Time convention: the observation before control step t holds the pose to reach by the end of
+step t (``target``); the reward after step t scores the pose reached against that target.
+"""
+
+import collections
+
+import numpy as np
+from dm_control.suite import base as suite_base
+from dm_control.utils import rewards
+from dm_env import specs
+
+from softbench.robots import base
+from softbench.robots import physics as arm_physics
+
+INITIAL_ACTUATION = 0.2  # Largest |action| entry of the random actuation held before an episode.
+REWARD_TOLERANCE = 0.01  # Fraction of the arm length within which the reward is 1.
+REWARD_MARGIN = 0.1  # Fraction of the arm length at which the reward falls to 0.1.
+
+
+class SoftArmTask(suite_base.Task):
+  """Base task. Subclasses give ``targets_at`` (what to reach at a step) and the modules they
+  score; this class runs actions, observations, the start and the reward.
+
+  At the start of every episode the arm holds a random action, uniform in
+  [-initial_actuation, initial_actuation], for one control period from rest, so that episodes of
+  different seeds start from different poses (``initial_actuation=0`` starts at rest). That
+  action is the first ``previous_action`` observation.
+  """
+
+  def __init__(self, robot: base.SoftArm, initial_actuation: float = INITIAL_ACTUATION,
+               random=None):
+    if not 0.0 <= initial_actuation <= 1.0:
+      raise ValueError(f"initial_actuation must lie in [0, 1], got {initial_actuation}")
+    super().__init__(random=random)
+    self.robot = robot
+    self._initial_actuation = initial_actuation
+    self._previous_action = None
+    self._step = 0
+
+  @property
+  def step_index(self) -> int:
+    """Control steps taken in the current episode."""
+    return self._step
+
+  target_size = 6  # Entries of one module's target: position and orientation vector.
+
+  def targets_at(self, step: int) -> np.ndarray:
+    """(modules, 6 or 3): the poses to reach by the end of control step ``step``."""
+    raise NotImplementedError
+
+  @property
+  def num_steps(self) -> int:
+    """Control steps per episode."""
+    raise NotImplementedError
+
+  def scored_modules(self) -> tuple[int, ...]:
+    """1-based modules whose poses ``targets_at`` lists, in order."""
+    raise NotImplementedError
+
+  def action_spec(self, physics: arm_physics.SoftArmPhysics) -> specs.BoundedArray:
+    return specs.BoundedArray((physics.action_dim,), np.float64, -1.0, 1.0, name="action")
+
+  def initialize_episode(self, physics: arm_physics.SoftArmPhysics) -> None:
+    self._step = 0
+    size = self._initial_actuation
+    action = self.random.uniform(-size, size, physics.action_dim)
+    if size > 0:
+      physics.set_action(action)
+      physics.step(int(round(self.robot.control_timestep / physics.timestep())))
+      physics.data.time = 0.0
+    self._previous_action = action
+
+  def before_step(self, action: np.ndarray, physics: arm_physics.SoftArmPhysics) -> None:
+    physics.set_action(action)
+    self._previous_action = np.array(action, dtype=float)
+
+  def after_step(self, physics: arm_physics.SoftArmPhysics) -> None:
+    self._step += 1
+
+  def observation_spec(self, physics: arm_physics.SoftArmPhysics) -> collections.OrderedDict:
+    modules = (len(self.scored_modules()), self.target_size)
+    return collections.OrderedDict(
+        poses=specs.Array((physics.num_modules, 6), np.float64, name="poses"),
+        target=specs.Array(modules, np.float64, name="target"),
+        previous_action=specs.BoundedArray((physics.action_dim,), np.float64, -1.0, 1.0,
+                                           name="previous_action"))
+
+  def get_termination(self, physics: arm_physics.SoftArmPhysics) -> float | None:
+    return 1.0 if self._step >= self.num_steps else None
+
+  def get_observation(self, physics: arm_physics.SoftArmPhysics) -> collections.OrderedDict:
+    observation = collections.OrderedDict()
+    observation["poses"] = physics.module_poses()
+    observation["target"] = self.targets_at(self._step)
+    observation["previous_action"] = self._previous_action.copy()
+    return observation
+
+  def get_reward(self, physics: arm_physics.SoftArmPhysics) -> float:
+    """Mean over scored modules of a tolerance reward on the distance to the step's target."""
+    achieved = physics.module_poses()[np.array(self.scored_modules()) - 1, :3]
+    distance = np.linalg.norm(achieved - self.targets_at(self._step - 1)[:, :3], axis=-1)
+    length = self.robot.length
+    return float(np.mean(rewards.tolerance(distance, bounds=(0.0, REWARD_TOLERANCE * length),
+                                           margin=REWARD_MARGIN * length, sigmoid="long_tail")))

@@ -1,0 +1,167 @@
+"""Reference trajectories that the robot can follow, because the robot itself traced them.
+
+Each reference drives the simulated arm from rest with an actuation pattern and records every
+module's pose after each control period (``PoseRecorder``). The patterns bend every module alike
+towards a point moving in the planar actuation space of ``SoftArm.planar_action``:
+
+- ``circle``: ``CIRCLE_TURNS`` turns of radius ``CIRCLE_RADIUS``;
+- ``rectangle``: ``RECTANGLE_LAPS`` laps of a rectangle of half sides ``RECTANGLE_HALF_SIDES``,
+  at constant speed along the perimeter;
+- ``spiral``: ``SPIRAL_TURNS`` turns whose radius grows linearly to ``SPIRAL_MAX_RADIUS``;
+- ``babbling``: uniform random actions from a seed stream that motor-babbling datasets never
+  use, so the poses are held out from every training set (the paper's "test babbling").
+
+References are cached under ``softbench_home()/references``, keyed by a hash of everything that
+generates them (the robot's MJCF included), with a content hash checked on every load. The
+generating actions are stored for replay checks; tasks show controllers only the poses.
+"""
+
+import dataclasses
+import functools
+import hashlib
+import json
+import logging
+import os
+import zipfile
+
+import numpy as np
+
+from softbench import storage
+from softbench.data import seeding
+from softbench.robots import base
+from softbench.robots import recorder
+
+REFERENCE_LENGTH = 1000  # Target poses per reference (paper: 1,000 samples per trajectory).
+BEND_DEG = 60.0  # (deg) End-effector bend at one bend amplitude.
+CIRCLE_RADIUS = 0.8  # Bend amplitudes.
+CIRCLE_TURNS = 4
+RECTANGLE_HALF_SIDES = (0.9, 0.5)  # Bend amplitudes along x and y.
+RECTANGLE_LAPS = 4
+SPIRAL_TURNS = 5
+LEAD_IN = 0.05  # Fraction of the steps over which circle and rectangle grow from the centre.
+AMPLITUDE_GRID = np.linspace(0.05, 1.0, 20)  # Actuations tried when calibrating the amplitude.
+SETTLE_SECONDS = 3.0  # (s) Hold per calibration actuation; longer than any settling time.
+SHAPES = ("babbling", "circle", "rectangle", "spiral")
+FORMAT_VERSION = 1
+
+_log = logging.getLogger(__name__)
+
+
+def _phases(length: int, cycles: float) -> np.ndarray:
+  """Phase in cycles of each control step; step t's target is reached after t + 1 actions."""
+  return cycles * np.arange(1, length + 1) / length
+
+
+def _on_circle(radius: np.ndarray | float, phase: np.ndarray) -> np.ndarray:
+  angle = 2 * np.pi * phase
+  return np.stack([radius * np.cos(angle), radius * np.sin(angle)], axis=-1)
+
+
+def _on_rectangle(phase: np.ndarray) -> np.ndarray:
+  half_x, half_y = RECTANGLE_HALF_SIDES
+  corners = np.array([[half_x, -half_y], [half_x, half_y], [-half_x, half_y], [-half_x, -half_y],
+                      [half_x, -half_y]])
+  distance = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(corners, axis=0), axis=1))])
+  along = (phase % 1.0) * distance[-1]
+  return np.stack([np.interp(along, distance, corners[:, 0]),
+                   np.interp(along, distance, corners[:, 1])], axis=-1)
+
+
+@functools.lru_cache(maxsize=None)
+def bend_amplitude(robot: base.SoftArm) -> float:
+  """The planar actuation (fraction of full) that bends the end effector by ``BEND_DEG`` at
+  equilibrium, interpolated on ``AMPLITUDE_GRID`` below the first grid point that reaches it."""
+  holds = int(np.ceil(SETTLE_SECONDS / robot.control_timestep))
+  points = np.stack([AMPLITUDE_GRID, np.zeros_like(AMPLITUDE_GRID)], axis=-1)
+  actions = np.repeat(robot.planar_action(points)[:, None], holds, axis=1)
+  poses, _ = recorder.PoseRecorder(robot, workers=os.cpu_count() or 1).record(actions)
+  rest_axis = poses[0, 0, -1, 3:]
+  bends = np.degrees(np.arccos(np.clip(poses[:, -1, -1, 3:] @ rest_axis, -1.0, 1.0)))
+  reached = np.flatnonzero(bends >= BEND_DEG)
+  if len(reached) == 0:
+    return 1.0
+  first = reached[0]
+  if first == 0:
+    return float(AMPLITUDE_GRID[0])
+  return float(np.interp(BEND_DEG, bends[first - 1:first + 1], AMPLITUDE_GRID[first - 1:first + 1]))
+
+
+def pattern_actions(robot: base.SoftArm, shape: str, length: int = REFERENCE_LENGTH,
+                    amplitude: float | None = None) -> np.ndarray:
+  """The generating actions (length, action_dim) of reference ``shape``; ``amplitude`` is
+  ``bend_amplitude(robot)`` unless given."""
+  if shape not in SHAPES:
+    raise ValueError(f"unknown reference shape {shape!r}; choose one of {', '.join(SHAPES)}")
+  if shape == "babbling":
+    stream = seeding.rng(0, seeding.HELD_OUT_BABBLING_STREAM)
+    return stream.uniform(-1.0, 1.0, (length, robot.action_dim))
+  amplitude = bend_amplitude(robot) if amplitude is None else amplitude
+  lead_in = np.minimum(1.0, np.arange(1, length + 1) / (LEAD_IN * length))[:, None]
+  if shape == "circle":
+    points = lead_in * _on_circle(CIRCLE_RADIUS, _phases(length, CIRCLE_TURNS))
+  elif shape == "rectangle":
+    points = lead_in * _on_rectangle(_phases(length, RECTANGLE_LAPS))
+  else:
+    points = _on_circle(_phases(length, 1.0), _phases(length, SPIRAL_TURNS))
+  return robot.planar_action(amplitude * points)
+
+
+@dataclasses.dataclass(frozen=True)
+class Reference:
+  """A recorded reference: ``poses[0]`` is the rest pose, ``poses[t + 1]`` the pose reached by
+  holding ``actions[t]``."""
+
+  shape: str
+  actions: np.ndarray  # (length, action_dim)
+  poses: np.ndarray  # (length + 1, num_modules, 6)
+
+  @property
+  def targets(self) -> np.ndarray:
+    """(length, num_modules, 6): the pose to reach at each control step."""
+    return self.poses[1:]
+
+
+def _config(robot: base.SoftArm, shape: str, length: int) -> dict:
+  return {"format": FORMAT_VERSION, "robot": robot.name, "shape": shape, "length": length,
+          "robot_xml_sha256": hashlib.sha256(robot.to_xml().encode()).hexdigest(),
+          "bend_deg": BEND_DEG, "amplitude_grid": AMPLITUDE_GRID.tolist(), "lead_in": LEAD_IN,
+          "circle": [CIRCLE_RADIUS, CIRCLE_TURNS],
+          "rectangle": [*RECTANGLE_HALF_SIDES, RECTANGLE_LAPS], "spiral": [SPIRAL_TURNS]}
+
+
+def _load_cached(path, config: dict) -> Reference | None:
+  meta_path = path.with_suffix(".json")
+  if not path.exists() or not meta_path.exists():
+    return None
+  try:
+    meta = json.loads(meta_path.read_text())
+    with np.load(path) as stored:
+      arrays = {"actions": stored["actions"], "poses": stored["poses"]}
+    if meta["config"] != config or meta["sha256"] != storage.arrays_sha256(arrays):
+      raise ValueError("content does not match its hash")
+  except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as error:
+    _log.warning("softbench: cached reference %s is unreadable (%s); generating it again",
+                 path, str(error).splitlines()[0] if str(error) else type(error).__name__)
+    return None
+  return Reference(config["shape"], arrays["actions"], arrays["poses"])
+
+
+def reference(robot: base.SoftArm, shape: str, length: int = REFERENCE_LENGTH) -> Reference:
+  """The reference ``shape`` of ``robot``, from the cache or simulated (and then cached)."""
+  if not (isinstance(length, int) and length >= 1):
+    raise ValueError(f"reference length must be a positive integer, got {length!r}")
+  if shape not in SHAPES:
+    raise ValueError(f"unknown reference shape {shape!r}; choose one of {', '.join(SHAPES)}")
+  config = _config(robot, shape, length)
+  key = hashlib.sha256(json.dumps(config, sort_keys=True).encode()).hexdigest()[:12]
+  path = storage.softbench_home() / "references" / f"{robot.name}-{shape}-n{length}-{key}.npz"
+  cached = _load_cached(path, config)
+  if cached is not None:
+    return cached
+  actions = pattern_actions(robot, shape, length)
+  poses, _ = recorder.PoseRecorder(robot).record(actions[None])
+  arrays = {"actions": actions, "poses": poses[0]}
+  storage.write_atomically(path, storage.npz_bytes(arrays))
+  storage.write_atomically(path.with_suffix(".json"), json.dumps(
+      {"config": config, "sha256": storage.arrays_sha256(arrays)}, indent=2) + "\n")
+  return Reference(shape, actions, poses[0])

@@ -1,0 +1,62 @@
+"""A user's own target trajectory: an array, or a ``.npy`` or ``.csv`` file, one target per row.
+
+A row lists every module's target pose in module order: tip position (m, world frame, the base
+at the origin and the arm hanging along -z) then unit orientation vector, so a row of an
+N-module arm has 6N numbers. A ``.csv`` file has no header; lines starting with ``#`` are
+comments. An array may also be given as (steps, N, 6).
+"""
+
+import pathlib
+
+import numpy as np
+
+from softbench.robots import base
+
+UNIT_TOLERANCE = 1e-3  # Largest accepted | |orientation vector| - 1 |.
+
+
+def _read(path: pathlib.Path) -> np.ndarray:
+  if not path.is_file():
+    raise ValueError(f"trajectory file {path} does not exist")
+  try:
+    if path.suffix == ".npy":
+      return np.load(path, allow_pickle=False)
+    if path.suffix == ".csv":
+      return np.loadtxt(path, delimiter=",", comments="#", ndmin=2)
+  except (OSError, ValueError, EOFError) as error:
+    raise ValueError(f"trajectory file {path} is unreadable: {str(error).splitlines()[0]}")
+  raise ValueError(f"trajectory file {path} must be .npy or .csv")
+
+
+def load_trajectory(source, robot: base.SoftArm) -> np.ndarray:
+  """Target poses (steps, num_modules, 6) from an array or a file path.
+
+  Raises:
+    ValueError: unreadable file, wrong shape (the message names the expected one), non-finite
+      values or orientation vectors that are not unit length.
+  """
+  modules = robot.num_modules
+  expected = f"(steps, {6 * modules}): per row, each of the {modules} module(s)' tip position (m) " \
+             f"and unit orientation vector"
+  if isinstance(source, (str, pathlib.Path)):
+    array = _read(pathlib.Path(source))
+  else:
+    array = np.asarray(source)
+  if not np.issubdtype(array.dtype, np.number):
+    raise ValueError(f"trajectory must be numeric, got dtype {array.dtype}")
+  array = array.astype(float)
+  if array.ndim == 3 and array.shape[1:] == (modules, 6):
+    targets = array
+  elif array.ndim == 2 and array.shape[1] == 6 * modules:
+    targets = array.reshape(len(array), modules, 6)
+  else:
+    raise ValueError(f"trajectory for {robot.name} must have shape {expected}; got {array.shape}")
+  if len(targets) == 0:
+    raise ValueError(f"trajectory for {robot.name} has no rows; expected shape {expected}")
+  if not np.all(np.isfinite(targets)):
+    raise ValueError("trajectory contains NaN or infinite values")
+  norms = np.linalg.norm(targets[..., 3:], axis=-1)
+  if np.any(np.abs(norms - 1.0) > UNIT_TOLERANCE):
+    row = int(np.argwhere(np.abs(norms - 1.0) > UNIT_TOLERANCE)[0, 0])
+    raise ValueError(f"trajectory row {row}: orientation vectors must have unit length")
+  return targets

@@ -1,0 +1,259 @@
+"""Properties of every task on every benchmark robot, in the style of dm_control's suite_test.
+
+Episodes are shortened (``length``/``steps``) so that the whole file runs in well under a minute;
+the properties do not depend on the length.
+"""
+
+import json
+
+import numpy as np
+import pytest
+from dm_env import specs
+
+from softbench import robots
+from softbench import suite
+from softbench.robots import recorder
+from softbench.suite import references
+
+SHORT = {"length": 3}  # Options that shorten each task's episode.
+SHORT_OPTIONS = {"babbling": SHORT, "circle": SHORT, "rectangle": SHORT, "spiral": SHORT,
+                 "reach": {"steps": 2}}
+
+
+@pytest.fixture(autouse=True)
+def shared_cache(tmp_path_factory, monkeypatch):
+  """One temporary data home for the whole file, so references are simulated once."""
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path_factory.getbasetemp() / "softbench_home"))
+
+
+def short_env(robot, task, seed=0, **options):
+  return suite.load(robot, task, seed=seed, **{**SHORT_OPTIONS[task], **options})
+
+
+def random_actions(env, seed=0):
+  rng = np.random.default_rng(seed)
+  spec = env.action_spec()
+  while True:
+    yield rng.uniform(spec.minimum, spec.maximum, spec.shape)
+
+
+def run_episode(env, seed=0):
+  """The observations and rewards of one episode under random actions."""
+  time_step = env.reset()
+  observations, rewards = [time_step.observation], []
+  for action in random_actions(env, seed):
+    time_step = env.step(action)
+    observations.append(time_step.observation)
+    rewards.append(time_step.reward)
+    if time_step.last():
+      return observations, rewards
+
+
+@pytest.mark.parametrize("robot,task", suite.ALL_TASKS)
+class TestEveryTask:
+
+  def test_observations_match_specs_and_are_finite(self, robot, task):
+    env = short_env(robot, task)
+    observation_spec = env.observation_spec()
+    observations, _ = run_episode(env)
+    for observation in observations:
+      assert set(observation) == {"poses", "target", "previous_action"}
+      for name, value in observation.items():
+        observation_spec[name].validate(value)
+        assert np.all(np.isfinite(value)), name
+
+  def test_actions_are_bounded_to_unit_box(self, robot, task):
+    spec = short_env(robot, task).action_spec()
+    assert isinstance(spec, specs.BoundedArray)
+    assert spec.shape == (robots.make(robot).action_dim,)
+    np.testing.assert_array_equal(spec.minimum, -1.0)
+    np.testing.assert_array_equal(spec.maximum, 1.0)
+
+  def test_rewards_lie_in_unit_interval_and_episode_ends(self, robot, task):
+    env = short_env(robot, task)
+    _, rewards = run_episode(env)
+    assert len(rewards) == env.task.num_steps
+    assert all(0.0 <= reward <= 1.0 for reward in rewards)
+
+  def test_same_seed_gives_same_episode(self, robot, task):
+    first, first_rewards = run_episode(short_env(robot, task, seed=3), seed=5)
+    second, second_rewards = run_episode(short_env(robot, task, seed=3), seed=5)
+    assert first_rewards == second_rewards
+    for a, b in zip(first, second):
+      for name in a:
+        np.testing.assert_array_equal(a[name], b[name])
+
+  def test_resets_differ_across_seeds(self, robot, task):
+    first = short_env(robot, task, seed=1).reset().observation
+    second = short_env(robot, task, seed=2).reset().observation
+    assert not np.array_equal(first["poses"], second["poses"])
+
+  def test_rejects_nan_and_out_of_range_actions(self, robot, task):
+    env = short_env(robot, task)
+    env.reset()
+    action = np.zeros(env.action_spec().shape)
+    with pytest.raises(ValueError, match="NaN"):
+      env.step(np.full_like(action, np.nan))
+    with pytest.raises(ValueError, match=r"\[-1, 1\]"):
+      env.step(action + 1.5)
+
+
+@pytest.mark.parametrize("robot", robots.BENCHMARK_ROBOTS)
+@pytest.mark.parametrize("shape", references.SHAPES)
+def test_every_reference_is_reachable(robot, shape):
+  """Replaying a reference's generating actions from rest reproduces its poses exactly."""
+  reference = references.reference(robots.make(robot), shape, length=4)
+  env = suite.load(robot, shape, length=4, initial_actuation=0.0)
+  env.reset()
+  achieved = []
+  for action in reference.actions:
+    achieved.append(env.step(action).observation["poses"])
+    assert env.physics.data.warning.number.sum() == 0
+  np.testing.assert_allclose(np.array(achieved), reference.targets, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("robot", robots.BENCHMARK_ROBOTS)
+def test_bend_amplitude_bends_the_end_effector_by_the_stated_angle(robot):
+  arm = robots.make(robot)
+  amplitude = references.bend_amplitude(arm)
+  holds = int(np.ceil(references.SETTLE_SECONDS / arm.control_timestep))
+  action = arm.planar_action(np.array([amplitude, 0.0]))
+  poses, _ = recorder.PoseRecorder(arm).record(np.tile(action, (1, holds, 1)))
+  axis, rest_axis = poses[0, -1, -1, 3:], poses[0, 0, -1, 3:]
+  bend = np.degrees(np.arccos(np.clip(axis @ rest_axis, -1, 1)))
+  assert abs(bend - references.BEND_DEG) < 3.0
+
+
+def test_reference_shapes_differ_and_stay_in_unit_actuation():
+  arm = robots.make("pneumatic-433")
+  actions = {shape: references.pattern_actions(arm, shape, 50, amplitude=0.5)
+             for shape in references.SHAPES}
+  for shape, action in actions.items():
+    assert action.shape == (50, arm.action_dim)
+    assert np.all(np.abs(action) <= 1.0), shape
+  for shape in ("circle", "rectangle", "spiral"):
+    assert not np.array_equal(actions[shape], actions["babbling"])
+  # The spiral grows outward: later actuation is larger than early actuation.
+  magnitude = np.linalg.norm(actions["spiral"], axis=1)
+  assert magnitude[:10].mean() < magnitude[-10:].mean()
+
+
+def test_reference_is_cached_and_a_corrupt_cache_is_regenerated(monkeypatch, tmp_path, caplog):
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
+  arm = robots.make("tendon-1")
+  first = references.reference(arm, "circle", length=5)
+  (npz,) = (tmp_path / "references").glob("*.npz")
+
+  def must_not_simulate(*args, **kwargs):
+    raise AssertionError("a cached reference was simulated again")
+
+  with monkeypatch.context() as patch:
+    patch.setattr(recorder.PoseRecorder, "record", must_not_simulate)
+    cached = references.reference(arm, "circle", length=5)
+  np.testing.assert_array_equal(cached.poses, first.poses)
+
+  data = bytearray(npz.read_bytes())
+  data[len(data) // 2] ^= 0xFF
+  npz.write_bytes(bytes(data))
+  regenerated = references.reference(arm, "circle", length=5)
+  assert "unreadable" in caplog.text
+  np.testing.assert_array_equal(regenerated.poses, first.poses)
+  meta = json.loads(npz.with_suffix(".json").read_text())
+  assert meta["config"]["shape"] == "circle"
+
+
+def test_reach_targets_are_reachable_points_that_vary_with_seed():
+  arm = robots.make("tendon-3")
+  targets = []
+  for seed in (0, 1):
+    env = suite.load(arm, "reach", seed=seed, steps=1)
+    observation = env.reset().observation
+    assert observation["target"].shape == (1, 3)
+    targets.append(observation["target"][0])
+    assert np.linalg.norm(targets[-1]) <= arm.length
+  assert not np.allclose(targets[0], targets[1])
+  assert suite.load(arm, "reach", steps=1).task.scored_modules() == (2,)
+
+
+def test_reward_is_one_on_target_and_falls_with_distance():
+  arm = robots.make("tendon-2")
+  rest = recorder.PoseRecorder(arm).poses(recorder.PoseRecorder(arm).rest_state())
+  shifted = rest.copy()
+  shifted[:, 0] += 0.05 * arm.length  # 5 % of the arm length away along x.
+  env = suite.load(arm, "custom", trajectory=np.stack([rest, shifted]), initial_actuation=0.0)
+  env.reset()
+  zero = np.zeros(arm.action_dim)
+  assert env.step(zero).reward == pytest.approx(1.0)
+  assert 0.1 < env.step(zero).reward < 1.0
+
+
+class TestCustomTrajectory:
+
+  @pytest.fixture
+  def rows(self):
+    arm = robots.make("tendon-2")
+    rest = recorder.PoseRecorder(arm).poses(recorder.PoseRecorder(arm).rest_state())
+    return np.tile(rest.reshape(1, -1), (4, 1))
+
+  @pytest.mark.parametrize("suffix", [".npy", ".csv"])
+  def test_file_gives_the_same_targets_as_the_array(self, rows, tmp_path, suffix):
+    path = tmp_path / f"trajectory{suffix}"
+    if suffix == ".npy":
+      np.save(path, rows)
+    else:
+      np.savetxt(path, rows, delimiter=",", header="x1,y1,z1,u1,v1,w1,x2,y2,z2,u2,v2,w2")
+    from_file = suite.load("tendon-2", "custom", trajectory=path).reset().observation["target"]
+    from_array = suite.load("tendon-2", "custom", trajectory=rows).reset().observation["target"]
+    np.testing.assert_allclose(from_file, from_array, atol=1e-15)
+    assert suite.load("tendon-2", "custom", trajectory=path).task.num_steps == 4
+
+  @pytest.mark.parametrize("change,message", [
+      (lambda rows: rows[:, :6], r"\(steps, 12\)"),
+      (lambda rows: rows[0], r"\(steps, 12\)"),
+      (lambda rows: rows[:0], "no rows"),
+      (lambda rows: np.where(np.arange(12) == 2, np.nan, rows), "NaN"),
+      (lambda rows: rows * 2, "unit length"),
+  ])
+  def test_malformed_trajectory_gets_a_clear_error(self, rows, change, message):
+    with pytest.raises(ValueError, match=message):
+      suite.load("tendon-2", "custom", trajectory=change(rows))
+
+  def test_unreadable_files(self, tmp_path):
+    with pytest.raises(ValueError, match="does not exist"):
+      suite.load("tendon-2", "custom", trajectory=tmp_path / "missing.npy")
+    (tmp_path / "bad.csv").write_text("1,2,three\n")
+    with pytest.raises(ValueError, match="unreadable"):
+      suite.load("tendon-2", "custom", trajectory=tmp_path / "bad.csv")
+    (tmp_path / "bad.npy").write_bytes(b"\x93NUMPY garbage")
+    with pytest.raises(ValueError, match="unreadable"):
+      suite.load("tendon-2", "custom", trajectory=tmp_path / "bad.npy")
+    (tmp_path / "trajectory.txt").write_text("0\n")
+    with pytest.raises(ValueError, match=".npy or .csv"):
+      suite.load("tendon-2", "custom", trajectory=tmp_path / "trajectory.txt")
+
+  def test_missing_trajectory(self):
+    with pytest.raises(ValueError, match="needs a trajectory"):
+      suite.load("tendon-2", "custom")
+
+
+@pytest.mark.parametrize("call,message", [
+    (lambda: suite.load("tendon-3", "juggle"), "unknown task 'juggle'"),
+    (lambda: suite.load("octopus-8", "circle"), "unknown robot"),
+    (lambda: suite.load("tendon-11", "circle"), "1 to 10 modules"),
+    (lambda: suite.load("tendon-3", "circle", speed=2), "no option 'speed'"),
+    (lambda: suite.load("tendon-3", "circle", length=0), "positive integer"),
+    (lambda: suite.load("tendon-3", "reach", module=4), "module must be 1 to 3"),
+    (lambda: suite.load("tendon-3", "reach", steps=0), "positive integer"),
+    (lambda: suite.load("tendon-3", "circle", length=2, initial_actuation=2.0), r"\[0, 1\]"),
+])
+def test_bad_arguments_get_one_line_errors(call, message):
+  with pytest.raises(ValueError, match=message) as error:
+    call()
+  assert "\n" not in str(error.value)
+
+
+def test_registry_lists():
+  assert set(suite.TASKS) == {"babbling", "circle", "rectangle", "spiral", "reach", "custom"}
+  assert len(suite.ALL_TASKS) == len(robots.BENCHMARK_ROBOTS) * 5
+  assert set(suite.BENCHMARKING) <= set(suite.ALL_TASKS)
+  assert ("tendon-3", "spiral") in suite.BENCHMARKING
