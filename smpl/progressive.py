@@ -87,8 +87,11 @@ class ProgressiveLSTM(InverseModel):
 
     Inputs are given either as one tensor per column (columns may differ in input size), or as a
     single tensor for the chosen column from which every earlier column reads the leading features
-    it needs. The latter suits Exp1S: with inputs [target, error, previous action of modules 1..k],
-    column j < k reads [target, error, previous action of modules 1..j].
+    it needs, zero-padded on the right if it reads more. A shared tensor suits Exp1S: with inputs
+    [target, error, previous action of modules 1..k], column j < k reads [target, error, previous
+    action of modules 1..j]. Padding suits Exp2R, where module 1 (4 bellows) is wider than
+    modules 2 and 3 (3 bellows): every column reads the input of the module being controlled, as
+    in a standard progressive network, and the missing previous-action entry reads 0.
     """
 
     def __init__(self, hidden_size: int = HIDDEN_SIZE, num_lstm_layers: int = LSTM_LAYERS) -> None:
@@ -211,16 +214,7 @@ class ProgressiveLSTM(InverseModel):
                 raise ValueError(
                     f"column {column} reads {columns[-1].input_size} input features, got {width}"
                 )
-            for index, earlier in enumerate(columns):
-                if earlier.input_size > width:
-                    raise ValueError(
-                        f"column {index} reads {earlier.input_size} input features but the shared "
-                        f"input has {width}; pass one input tensor per column instead"
-                    )
-            return [
-                inputs if earlier.input_size == width else inputs[..., : earlier.input_size]
-                for earlier in columns
-            ]
+            return [_fit_width(inputs, earlier.input_size) for earlier in columns]
         if len(inputs) < column + 1:
             raise ValueError(
                 f"column {column} needs inputs for {column + 1} columns, got {len(inputs)}"
@@ -270,6 +264,14 @@ class ProgressiveColumn(InverseModel):
         self, inputs: Tensor | Sequence[Tensor], state: tuple[ColumnState, ...]
     ) -> InverseStep:
         return self.network.step(inputs, state, self.column)
+
+
+def _fit_width(inputs: Tensor, width: int) -> Tensor:
+    """The first `width` features of `inputs`, zero-padded on the right if it has fewer."""
+    available = inputs.shape[-1]
+    if available >= width:
+        return inputs if available == width else inputs[..., :width]
+    return nn.functional.pad(inputs, (0, width - available))
 
 
 def _run_sequence(

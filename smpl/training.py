@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -58,6 +59,11 @@ class TrainingConfig:
     seed: int = 0
     """Seeds batch shuffling and any sampling inside the model (the VAE's latent noise)."""
     cpu_threads: int = CPU_THREADS
+    compile: bool = False
+    """Compile the training loss and the optimiser step with `torch.compile` (Inductor): on the
+    2-core machine an SMPL column's closed-loop epoch over 9,695 windows fell from 2.9 s to 1.2 s,
+    after about 40 s of compilation (a few seconds once Inductor's on-disk cache holds it). Falls
+    back to eager, with a warning, where compilation fails. Validation stays eager."""
 
 
 @dataclass(frozen=True)
@@ -178,6 +184,9 @@ def fit(
     validation = validation.to(device)
     with seeded(config.seed, device), limited_cpu_threads(config.cpu_threads, device):
         optimizer = torch.optim.Adam(parameters, lr=config.learning_rate)
+        train_loss_of, step = batch_loss, optimizer.step
+        if config.compile:
+            train_loss_of, step = _compiled(batch_loss), _compiled(optimizer.step)
         shuffling = torch.Generator().manual_seed(config.seed)
         stopping = EarlyStopping(config.patience)
         best_state = _copy_state(model)
@@ -186,7 +195,7 @@ def fit(
             started = time.perf_counter()
             model.train()
             train_loss = _train_epoch(
-                model, batch_loss, train, optimizer, config.batch_size, shuffling
+                train_loss_of, step, optimizer, train, config.batch_size, shuffling
             )
             validation_loss = evaluate_loss(model, batch_loss, validation)
             improved = stopping.update(epoch, validation_loss)
@@ -299,10 +308,10 @@ def train_inverse_model(
 
 
 def _train_epoch(
-    model: nn.Module,
     batch_loss: BatchLoss,
-    train: BabblingWindows,
+    step: Callable[[], object],
     optimizer: torch.optim.Optimizer,
+    train: BabblingWindows,
     batch_size: int,
     shuffling: torch.Generator,
 ) -> float:
@@ -313,9 +322,31 @@ def _train_epoch(
         loss = batch_loss(train.subset(indices))
         optimizer.zero_grad(set_to_none=True)
         loss.backward()
-        optimizer.step()
+        step()
         total += loss.detach() * len(indices)
     return total.item() / len(train)
+
+
+def _compiled(function: Callable) -> Callable:
+    """`torch.compile(function)`, or `function` itself (with a warning) if compiling fails."""
+    # The LSTM layers run through torch.lstm_cell with nn.LSTM's weights; Dynamo refuses to touch
+    # nn.LSTM modules unless told that this is fine.
+    torch._dynamo.config.allow_rnn = True
+    compiled = torch.compile(function)
+    fell_back = False
+
+    def run(*args, **kwargs):
+        nonlocal fell_back
+        if not fell_back:
+            try:
+                return compiled(*args, **kwargs)
+            except Exception as error:  # Inductor needs a C++ compiler, among other things.
+                fell_back = True
+                warnings.warn(f"torch.compile failed ({type(error).__name__}); training in eager "
+                              f"mode", RuntimeWarning, stacklevel=2)
+        return function(*args, **kwargs)
+
+    return run
 
 
 def _copy_state(model: nn.Module) -> dict[str, Tensor]:

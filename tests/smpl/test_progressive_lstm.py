@@ -126,12 +126,13 @@ def test_shared_input_gives_earlier_columns_its_leading_features() -> None:
     assert torch.equal(network(shared)[0], network(per_column)[0])
 
 
-def test_shared_input_narrower_than_an_earlier_column_is_refused() -> None:
+def test_shared_input_narrower_than_an_earlier_column_is_zero_padded_for_it() -> None:
     network = ProgressiveLSTM(hidden_size=8)
     network.add_column(10, 2)
     network.add_column(6, 2)
-    with pytest.raises(ValueError, match="column 0 reads 10"):
-        network(torch.randn(BATCH, STEPS, 6))
+    shared = torch.randn(BATCH, STEPS, 6)
+    padded = torch.cat([shared, torch.zeros(BATCH, STEPS, 4)], dim=-1)
+    assert torch.equal(network(shared)[0], network([padded, shared])[0])
 
 
 def test_state_of_the_wrong_number_of_columns_is_refused() -> None:

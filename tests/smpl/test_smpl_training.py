@@ -1,5 +1,6 @@
 import dataclasses
 import io
+import warnings
 
 import pytest
 import torch
@@ -218,3 +219,23 @@ def test_progress_bar_shows_epochs_done_and_the_latest_losses(
     shown = output.getvalue()
     assert "column 1" in shown and f"{result.epochs_run}/{SHORT_RUN.max_epochs}" in shown
     assert f"best {result.best_validation_loss:.2e}" in shown
+
+
+def test_compiled_training_matches_eager_training(
+    arm_data: dict[str, BabblingWindows], trained_forward_model: ForwardModel
+) -> None:
+    """torch.compile changes only float rounding: the same run lands on nearly the same losses."""
+    results = {}
+    for compile_ in (False, True):
+        network = _fresh_column()
+        config = dataclasses.replace(SHORT_RUN, max_epochs=2, compile=compile_)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", RuntimeWarning)
+            result = train_inverse_model(
+                network, trained_forward_model, arm_data["train"], arm_data["validation"], config,
+                CPU,
+            )
+        fallbacks = [w for w in caught if "torch.compile failed" in str(w.message)]
+        results[compile_] = [report.train_loss for report in result.history]
+    assert not fallbacks, "torch.compile fell back to eager"
+    assert results[True] == pytest.approx(results[False], rel=1e-3)

@@ -1,0 +1,111 @@
+"""The paper's SMPL protocols on softbench's babbling data (SPEC section 5).
+
+- ``exp1s`` (continual): tendon-1 .. tendon-5 in sequence, one new column per configuration,
+  each learning the end effector's pose from every action of that configuration;
+- ``exp2s`` (distributed, tendon-3) and ``exp2r`` (distributed, pneumatic-433): one column per
+  module, each learning its module's pose and actions, with a forward model of its own that also
+  reads the preceding modules' actuation.
+
+Every column has its own dataset view, normalisation (fitted on its training split) and frozen
+forward model; ``smpl.protocol.train_progressively`` adds and trains the columns in order and
+scores every column seen so far after each stage, which gives the forgetting matrix.
+"""
+
+import dataclasses
+from collections.abc import Callable
+
+import torch
+
+from smpl import forward_model as smpl_forward
+from smpl import progressive
+from smpl import protocol as smpl_protocol
+from smpl import training
+from softbench import data
+from softbench import robots
+
+
+@dataclasses.dataclass(frozen=True)
+class Protocol:
+  """A sequence of columns: one per robot (``per_module=False``) or per module of one robot."""
+
+  name: str
+  robot_names: tuple[str, ...]
+  per_module: bool
+  description: str
+
+  def column_views(self) -> list[tuple[robots.SoftArm, data.View]]:
+    """The robot and data view of each column, in training order."""
+    arms = [robots.make(name) for name in self.robot_names]
+    if self.per_module:
+      return [(arm, data.View.module(arm, module)) for arm in arms
+              for module in range(1, arm.num_modules + 1)]
+    return [(arm, data.View.end_effector(arm)) for arm in arms]
+
+
+PROTOCOLS = {
+    "exp1s": Protocol("exp1s", tuple(f"tendon-{n}" for n in range(1, 6)), False,
+                      "continual: a new column for each of tendon-1 .. tendon-5"),
+    "exp2s": Protocol("exp2s", ("tendon-3",), True, "distributed: a column per module of tendon-3"),
+    "exp2r": Protocol("exp2r", ("pneumatic-433",), True,
+                      "distributed: a column per module of pneumatic-433"),
+}
+
+
+def get(name: str) -> Protocol:
+  if name not in PROTOCOLS:
+    raise ValueError(f"unknown protocol {name!r}; choose one of {', '.join(PROTOCOLS)}")
+  return PROTOCOLS[name]
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class PreparedColumn:
+  """What one column learns from: the robot, its windows (with normalisation) and a frozen
+  forward model trained on them."""
+
+  robot: robots.SoftArm
+  windows: data.SplitWindows
+  forward_model: smpl_forward.ForwardModel
+  forward_training: training.TrainingResult
+
+  @property
+  def task(self) -> smpl_protocol.ColumnTask:
+    return smpl_protocol.ColumnTask(self.windows.train, self.windows.validation,
+                                    self.windows.test, self.forward_model)
+
+
+def prepare_column(robot: robots.SoftArm, view: data.View, dataset: data.Dataset,
+                   config: training.ForwardTrainingConfig = training.ForwardTrainingConfig(),
+                   device: torch.device | None = None,
+                   on_epoch_end: Callable[[training.EpochReport], None] | None = None
+                   ) -> PreparedColumn:
+  """Cuts ``view``'s windows from ``dataset`` and trains (then freezes) its forward model."""
+  windows = data.windows(dataset, view)
+  with training.seeded(config.seed, torch.device("cpu")):
+    model = smpl_forward.ForwardModel(windows.train.actuation_size, windows.train.pose_size)
+  result = training.train_forward_model(model, windows.train, windows.validation, config, device,
+                                        on_epoch_end)
+  return PreparedColumn(robot, windows, model, result)
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class ProtocolResult:
+  protocol: Protocol
+  network: progressive.ProgressiveLSTM
+  columns: list[PreparedColumn]
+  run: smpl_protocol.ProgressiveRun
+
+
+def run(protocol: Protocol, samples: int = data.DEFAULT_SAMPLES, seed: int = 0,
+        forward_config: training.ForwardTrainingConfig = training.ForwardTrainingConfig(),
+        inverse_config: training.InverseTrainingConfig = training.InverseTrainingConfig(),
+        device: torch.device | None = None, progress: bool = True) -> ProtocolResult:
+  """Collects (or finds) each robot's dataset, prepares every column, then trains the
+  progressive network column by column (``smpl.protocol.train_progressively``)."""
+  datasets = {name: data.collect(name, samples=samples, seed=seed, progress=progress)
+              for name in protocol.robot_names}
+  columns = [prepare_column(arm, view, datasets[arm.name], forward_config, device)
+             for arm, view in protocol.column_views()]
+  network = progressive.ProgressiveLSTM()
+  outcome = smpl_protocol.train_progressively(network, [column.task for column in columns],
+                                              inverse_config, device)
+  return ProtocolResult(protocol, network, columns, outcome)
