@@ -13,8 +13,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 run: $(STAMP)
-	$(VENV)/bin/softbench robots
-	$(VENV)/bin/softbench models export --out build/models
+	$(VENV)/bin/softbench run --task spiral --agent smpl
 
 test: $(STAMP)
 	$(VENV)/bin/python -m pytest -q tests

@@ -5,8 +5,11 @@ import argparse
 import pathlib
 import sys
 
+from softbench import agents
 from softbench import data
+from softbench import profiles
 from softbench import robots
+from softbench import run as run_module
 from softbench import suite
 from softbench.robots import export as model_export
 
@@ -67,6 +70,25 @@ def _collect(args: argparse.Namespace) -> None:
   print(dataset.path)
 
 
+def _agents(args: argparse.Namespace) -> None:
+  print(f"{'agent':<10} {'learns':<7} description")
+  for name in agents.AGENTS:
+    entry = agents.describe(name)
+    print(f"{name:<10} {'yes' if entry.learned else 'no':<7} {entry.description}")
+
+
+def _run(args: argparse.Namespace) -> None:
+  settings = run_module.settings(args.task, args.agent, args.robot, args.seeds, args.profile,
+                                 args.eval, args.trajectory)
+  record = run_module.execute(settings)
+  print(run_module.table(record))
+  path = run_module.record_path(record, pathlib.Path(args.results))
+  run_module.write_record(record, path)
+  print(f"result record: {path}")
+  if args.json:
+    run_module.write_record(record, pathlib.Path(args.json))
+
+
 def build_parser() -> argparse.ArgumentParser:
   parser = argparse.ArgumentParser(prog="softbench", description=__doc__.split(".")[0] + ".")
   commands = parser.add_subparsers(dest="command", required=True)
@@ -87,6 +109,27 @@ def build_parser() -> argparse.ArgumentParser:
   collect_parser.add_argument("--workers", type=int, default=None,
                               help="simulation threads (default: every core)")
   collect_parser.set_defaults(run=_collect)
+  agents_parser = commands.add_parser("agents", help="list the agents")
+  agents_parser.set_defaults(run=_agents)
+  run_parser = commands.add_parser(
+      "run", help="train (or reuse) an agent and score it on a task over seeds",
+      description="Collects or reuses the babbling dataset, trains or reuses the agent (cached "
+                  "by config), evaluates it closed loop and prints the errors over seeds.")
+  run_parser.add_argument("--task", required=True, help=f"one of {', '.join(suite.TASKS)}")
+  run_parser.add_argument("--agent", required=True, help=f"one of {', '.join(agents.AGENTS)}")
+  run_parser.add_argument("--robot", help="default: the task's robot in the paper (tendon-3; "
+                                          "pneumatic-433 for reach)")
+  run_parser.add_argument("--seeds", type=int, help="number of seeds (default: the profile's)")
+  run_parser.add_argument("--profile", default=profiles.DEFAULT_PROFILE,
+                          help=f"one of {', '.join(profiles.PROFILES)} "
+                               f"(default {profiles.DEFAULT_PROFILE})")
+  run_parser.add_argument("--eval", default="physics", help="physics (default), model or "
+                                                            "open-loop: the error fed back")
+  run_parser.add_argument("--trajectory", help="target poses for --task custom (.npy or .csv)")
+  run_parser.add_argument("--results", default="leaderboard/results",
+                          help="folder of the result records (default leaderboard/results)")
+  run_parser.add_argument("--json", help="also write the result record to this file")
+  run_parser.set_defaults(run=_run)
   models = commands.add_parser("models", help="exported MJCF models")
   models_commands = models.add_subparsers(dest="models_command", required=True)
   export_parser = models_commands.add_parser("export", help="write models/<name>/ for every robot")

@@ -14,6 +14,7 @@ import numpy as np
 
 BABBLING_STREAM = 0  # Training motor babbling (softbench.data.collect); index: episode.
 HELD_OUT_BABBLING_STREAM = 1  # The suite's held-out babbling trajectory (task `babbling`).
+RANDOM_AGENT_STREAM = 2  # The `random` agent's actions (softbench.agents.random_actions).
 
 
 def check_seed(seed: int) -> None:

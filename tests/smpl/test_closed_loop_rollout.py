@@ -9,7 +9,7 @@ from torch import Tensor, nn
 from smpl.forward_model import ForwardModel
 from smpl.inverse import InverseModel, InverseStep
 from smpl.progressive import ProgressiveLSTM
-from smpl.rollout import rollout
+from smpl.rollout import Rollout, rollout
 from smpl.windows import BabblingWindows
 
 POSE, ACTION, STEPS, BATCH = 6, 2, 15, 3
@@ -63,13 +63,14 @@ def _numbered_windows() -> BabblingWindows:
     )
 
 
+def _scripted_rollout() -> tuple[_ScriptedInverse, _RecordingForwardModel, Rollout]:
+    """A rollout of the scripted inverse model through the recording forward model."""
+    inverse, forward_model = _ScriptedInverse(), _RecordingForwardModel()
+    return inverse, forward_model, rollout(inverse, _numbered_windows(), forward_model)
+
+
 def test_each_step_reads_its_target_the_previous_steps_error_and_the_previous_action() -> None:
-    inverse, forward_model, windows = (
-        _ScriptedInverse(),
-        _RecordingForwardModel(),
-        _numbered_windows(),
-    )
-    result = rollout(inverse, windows, forward_model)
+    inverse, _, result = _scripted_rollout()
     offset = 1000.0 * torch.arange(BATCH)[:, None]
     for t in range(STEPS):
         target, error, previous_action = inverse.received[t].split([POSE, POSE, ACTION], dim=-1)
@@ -82,12 +83,7 @@ def test_each_step_reads_its_target_the_previous_steps_error_and_the_previous_ac
 
 
 def test_forward_model_sees_the_recorded_poses_and_the_action_of_the_same_step() -> None:
-    inverse, forward_model, windows = (
-        _ScriptedInverse(),
-        _RecordingForwardModel(),
-        _numbered_windows(),
-    )
-    result = rollout(inverse, windows, forward_model)
+    inverse, forward_model, result = _scripted_rollout()
     offset = 1000.0 * torch.arange(BATCH)[:, None]
     assert len(forward_model.calls) == STEPS
     for t, (previous_pose, current_pose, actuation) in enumerate(forward_model.calls):

@@ -1,0 +1,52 @@
+"""What every softbench agent is: a controller that reads a task's observations and returns an
+action in [-1, 1]^action_dim, once per control step.
+
+Observations are those of ``softbench.suite`` tasks (time convention in ``softbench.suite.base``):
+
+  poses            (num_modules, 6)  every module's tip position (m) and orientation vector now
+  target           (scored, 6 or 3)  the pose(s) to reach by the end of this step
+  previous_action  (action_dim,)     the action held during the last step
+
+An agent is built for one robot and seed by its registry entry (``softbench.agents.make``),
+trained there if it learns; ``reset`` starts an episode of a given task.
+"""
+
+import abc
+import dataclasses
+
+import numpy as np
+
+from softbench.robots import base as robot_base
+
+
+@dataclasses.dataclass(frozen=True)
+class EpisodeInfo:
+  """What an agent may know about the episode ahead: the task's name and scored modules."""
+
+  task: str
+  scored_modules: tuple[int, ...]
+
+
+class Agent(abc.ABC):
+  """A controller for one robot.
+
+  ``uses_simulator`` marks model-based agents: before every episode the evaluation hands them
+  the environment's physics (``bind``), which they may read (state, model) but must not change.
+  Learned agents see observations only.
+  """
+
+  uses_simulator = False
+
+  def __init__(self, robot: robot_base.SoftArm, seed: int):
+    self.robot = robot
+    self.seed = seed
+
+  def bind(self, physics) -> None:
+    """Gives a model-based agent the environment's ``SoftArmPhysics`` (read only)."""
+
+  def reset(self, episode: EpisodeInfo) -> None:
+    """Called before the first step of every episode."""
+
+  @abc.abstractmethod
+  def act(self, observation: dict) -> np.ndarray:
+    """The action (action_dim,) in [-1, 1] for this control step."""

@@ -1,0 +1,247 @@
+"""Learned agents: inverse models trained on motor babbling in closed loop, then acting on a task.
+
+Training (cached): the robot's babbling dataset (``softbench.data.collect``, data seed 0, the
+profile's sample count), cut into each controller's view; a forward model per view, then the
+inverse model in closed loop through it (``smpl.training``), seeded by the agent's seed. SMPL has
+one progressive column per module (``View.module``, trained in order, earlier columns frozen);
+the baselines are one centralised model over the whole arm (``View.whole_arm``).
+
+Acting, at control step t, each controller reads (normalised with its training statistics)
+
+    u_t = [x*_{t+1}, e_t, a_{t-1}],   e_t = x*_t - x_t   (physics: the measured pose x_t)
+
+where x*_{t+1} is this step's target and x*_t the previous one; e_0 = 0 and a_{-1} = 0 (SPEC 5).
+``error_source`` chooses e_t: ``physics`` (the headline), ``model`` (x_t replaced by the forward
+model's prediction, the paper's protocol) or ``open-loop`` (e_t = 0). Unscored modules (reach)
+hold their starting pose as target; a position-only target keeps the module's starting
+orientation, as in the paper's reaching experiment.
+"""
+
+import contextlib
+import dataclasses
+import hashlib
+from typing import Callable
+
+import numpy as np
+import torch
+
+from smpl import checkpoint
+from smpl import forward_model as smpl_forward
+from smpl import progress
+from smpl import progressive
+from smpl import training
+from smpl import windows as smpl_windows
+from smpl.inverse import InverseModel
+from softbench import data
+from softbench import profiles
+from softbench import protocols
+from softbench import storage
+from softbench.agents import base
+from softbench.robots import base as robot_base
+
+ERROR_SOURCES = ("physics", "model", "open-loop")
+CHECKPOINT_FOLDER = "checkpoints"
+DATA_SEED = 0  # Every agent and seed learns from the same babbling dataset.
+
+ModelFactory = Callable[[int, int], InverseModel]  # (input_size, action_size) -> model
+
+
+@dataclasses.dataclass(frozen=True)
+class TrainedConfig:
+  """Everything a trained agent's weights depend on; its hash names the checkpoint."""
+
+  agent: str
+  robot: str
+  robot_xml_sha256: str
+  views: tuple[str, ...]
+  samples: int
+  seed: int
+  max_epochs: int
+  patience: int
+  compile: bool
+
+  @property
+  def key(self) -> str:
+    text = repr(dataclasses.astuple(self)).encode()
+    return f"{self.agent}-{self.robot}-seed{self.seed}-{hashlib.sha256(text).hexdigest()[:12]}"
+
+
+@dataclasses.dataclass
+class Controller:
+  """One view's inverse model, forward model and normalisation, with its running state."""
+
+  view: data.View
+  inverse: InverseModel
+  forward: smpl_forward.ForwardModel
+  normalisation: data.Normalisation
+  state: object = None
+  forward_state: object = None
+
+
+class LearnedAgent(base.Agent):
+  """Acts with trained controllers; see the module docstring."""
+
+  def __init__(self, robot: robot_base.SoftArm, seed: int, controllers: list[Controller],
+               error_source: str = "physics"):
+    super().__init__(robot, seed)
+    self.controllers = controllers
+    self.error_source = error_source
+    self._reset_memory()
+
+  def _reset_memory(self) -> None:
+    self._previous_target = None  # x*_t, (num_modules, 6)
+    self._start_poses = None
+    self._previous_poses = None  # x_{t-1}
+    self._poses_before = None  # x_{t-2}
+    self._previous_action = np.zeros(self.robot.action_dim)
+
+  def reset(self, episode: base.EpisodeInfo) -> None:
+    if self.error_source not in ERROR_SOURCES:
+      raise ValueError(f"error_source must be one of {', '.join(ERROR_SOURCES)}, "
+                       f"got {self.error_source!r}")
+    self._scored = np.array(episode.scored_modules) - 1
+    self._reset_memory()
+    for controller in self.controllers:
+      controller.state = controller.inverse.initial_state(1)
+      controller.forward_state = controller.forward.initial_state(1)
+
+  def _full_target(self, target: np.ndarray) -> np.ndarray:
+    full = self._start_poses.copy()
+    full[self._scored, :target.shape[1]] = target
+    return full
+
+  def act(self, observation: dict) -> np.ndarray:
+    poses = np.asarray(observation["poses"], dtype=float)
+    if self._start_poses is None:
+      self._start_poses = poses.copy()
+      self._previous_poses = self._poses_before = poses.copy()  # x_{-1} = x_{-2} = x_0
+    target = self._full_target(np.asarray(observation["target"], dtype=float))
+    action = np.zeros(self.robot.action_dim)
+    with torch.no_grad():
+      for controller in self.controllers:
+        action[list(controller.view.action_indices)] = self._controller_action(
+            controller, target, poses)
+    action = np.clip(action, -1.0, 1.0)
+    self._previous_target = target
+    self._poses_before, self._previous_poses = self._previous_poses, poses
+    self._previous_action = action
+    return action
+
+  def _controller_action(self, controller: Controller, target: np.ndarray,
+                         poses: np.ndarray) -> np.ndarray:
+    view, scale = controller.view, controller.normalisation
+    as_tensor = lambda values: torch.as_tensor(values, dtype=torch.float32)[None]
+    pick = lambda full: scale.poses.normalise(view.select(full, self._previous_action)[0])
+    _, previous_own, previous_preceding = view.select(poses, self._previous_action)
+    previous_action = scale.actions.normalise(previous_own) if self._previous_target is not None \
+        else np.zeros(view.action_size)
+    error = np.zeros(view.pose_size)
+    if self._previous_target is not None and self.error_source == "physics":
+      error = pick(self._previous_target) - pick(poses)
+    elif self._previous_target is not None and self.error_source == "model":
+      # x'_t = forward(x_{t-2}, x_{t-1}, actuation a_{t-1}), one step behind as in training.
+      actuation = np.concatenate([scale.preceding_actions.normalise(previous_preceding),
+                                  previous_action])
+      predicted, controller.forward_state = controller.forward.step(
+          as_tensor(pick(self._poses_before)), as_tensor(pick(self._previous_poses)),
+          as_tensor(actuation), controller.forward_state)
+      error = pick(self._previous_target) - predicted[0].numpy()
+    inputs = smpl_windows.inverse_inputs(as_tensor(pick(target)), as_tensor(error),
+                                         as_tensor(previous_action))
+    step = controller.inverse.step(inputs, controller.state)
+    controller.state = step.state
+    return scale.actions.denormalise(step.action[0].numpy().astype(float))
+
+
+def _training_configs(seed: int, profile: profiles.Profile
+                      ) -> tuple[training.ForwardTrainingConfig, training.InverseTrainingConfig]:
+  common = dict(max_epochs=profile.max_epochs, patience=profile.patience, seed=seed,
+                compile=profile.compile)
+  return training.ForwardTrainingConfig(**common), training.InverseTrainingConfig(**common)
+
+
+def _input_size(view: data.View) -> int:
+  return smpl_windows.inverse_input_size(view.pose_size, view.action_size)
+
+
+def _models(views: list[data.View], per_module: bool, make_model: ModelFactory
+            ) -> tuple[InverseModel, list[smpl_forward.ForwardModel]]:
+  """Untrained models of the right sizes (the inverse network, and one forward model per view)."""
+  if per_module:
+    inverse = progressive.ProgressiveLSTM()
+    for view in views:
+      inverse.add_column(_input_size(view), view.action_size)
+  else:
+    (view,) = views
+    inverse = make_model(_input_size(view), view.action_size)
+  forwards = [smpl_forward.ForwardModel(view.preceding_action_size + view.action_size,
+                                        view.pose_size) for view in views]
+  return inverse, forwards
+
+
+def _bundle(inverse: InverseModel, forwards: list[smpl_forward.ForwardModel]) -> torch.nn.Module:
+  return torch.nn.ModuleDict({"inverse": inverse, "forward_models": torch.nn.ModuleList(forwards)})
+
+
+def _inverse_of(inverse: InverseModel, index: int, per_module: bool) -> InverseModel:
+  return inverse.column_model(index) if per_module else inverse
+
+
+def _progress_bar(label: str, epochs: int, show: bool):
+  return progress.EpochProgressBar(label, epochs) if show else contextlib.nullcontext(None)
+
+
+def _train(name: str, robot: robot_base.SoftArm, views: list[data.View], seed: int,
+           profile: profiles.Profile, per_module: bool, make_model: ModelFactory, show: bool
+           ) -> tuple[InverseModel, list[smpl_forward.ForwardModel], list[data.Normalisation]]:
+  """Collects or finds the dataset, then trains forward and inverse models (module docstring)."""
+  dataset = data.collect(robot, samples=profile.samples, seed=DATA_SEED, progress=show)
+  forward_config, inverse_config = _training_configs(seed, profile)
+  device = training.default_device()
+  with training.seeded(seed, torch.device("cpu")):
+    inverse, forwards = _models(views, per_module, make_model)
+  normalisations = []
+  for index, view in enumerate(views):
+    label = f"{name} {robot.name} seed {seed} {view.name}"
+    with _progress_bar(f"forward {label}", profile.max_epochs, show) as bar:
+      prepared = protocols.prepare_column(robot, view, dataset, forward_config, device, bar)
+    forwards[index] = prepared.forward_model
+    normalisations.append(prepared.windows.normalisation)
+    if per_module:  # Column by column: the earlier ones are trained and stay frozen.
+      inverse.columns.requires_grad_(False)
+      inverse.columns[index].requires_grad_(True)
+    with _progress_bar(f"inverse {label}", profile.max_epochs, show) as bar:
+      training.train_inverse_model(_inverse_of(inverse, index, per_module),
+                                   prepared.forward_model, prepared.windows.train,
+                                   prepared.windows.validation, inverse_config, device, bar)
+  inverse.requires_grad_(False)
+  return inverse, forwards, normalisations
+
+
+def build_agent(name: str, robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
+                per_module: bool, make_model: ModelFactory | None = None,
+                show_progress: bool = False) -> LearnedAgent:
+  """A trained learned agent: from the checkpoint cache, or trained now and then cached."""
+  views = ([data.View.module(robot, k) for k in range(1, robot.num_modules + 1)] if per_module
+           else [data.View.whole_arm(robot)])
+  config = TrainedConfig(name, robot.name, hashlib.sha256(robot.to_xml().encode()).hexdigest(),
+                         tuple(view.name for view in views), profile.samples, seed,
+                         profile.max_epochs, profile.patience, profile.compile)
+  path = storage.softbench_home() / CHECKPOINT_FOLDER / f"{config.key}.pt"
+  if path.exists():
+    inverse, forwards = _models(views, per_module, make_model)
+    arrays = checkpoint.load_checkpoint(path, _bundle(inverse, forwards), config)
+    normalisations = [data.Normalisation.from_arrays(
+        {key.removeprefix(f"{view.name}/"): value for key, value in arrays.items()
+         if key.startswith(f"{view.name}/")}) for view in views]
+  else:
+    inverse, forwards, normalisations = _train(name, robot, views, seed, profile, per_module,
+                                               make_model, show_progress)
+    arrays = {f"{view.name}/{key}": value for view, scale in zip(views, normalisations)
+              for key, value in scale.to_arrays().items()}
+    checkpoint.save_checkpoint(path, _bundle(inverse, forwards), config, arrays)
+  inverse.eval()
+  controllers = [Controller(view, _inverse_of(inverse, index, per_module), forward.eval(), scale)
+                 for index, (view, forward, scale) in enumerate(zip(views, forwards,
+                                                                     normalisations))]
+  return LearnedAgent(robot, seed, controllers)

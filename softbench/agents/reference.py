@@ -1,0 +1,169 @@
+"""``reference``: a model-based controller that plans on the simulator itself, to show how far the
+learned controllers are from what the physics allows.
+
+At every control step the agent copies the environment's full physics state (``mj_getState``; it
+never writes to the environment) and, on its own copy of the model, looks for the action that,
+held for one control period, brings the scored modules' tips to this step's target:
+
+- residual: tip positions over the arm's length (dimensionless), plus, for 6-entry targets, the
+  orientation vectors weighted by ``ORIENTATION_WEIGHT``;
+- start: the previous action, with a forward-difference Jacobian (``action_dim + 1`` one-period
+  simulations in one batch on MuJoCo's ``rollout`` thread pool);
+- up to ``ITERATIONS`` damped least-squares steps, one simulation each, at most ``MAX_STEP`` per
+  entry, inside [-1, 1] (entries pressed against a bound are held there and the others solved
+  again). An accepted step (it lowers the residual) updates the Jacobian by Broyden's rule; a
+  rejected one first refreshes the Jacobian by finite differences, then raises the damping;
+- a pull towards zero action (``EFFORT``) that fades with the residual, so that from far away
+  the arm takes the least-effort branch of a redundant target (reach) and, near the target, the
+  solution is unbiased;
+- stop when the residual is below ``TOLERANCE``.
+
+The constants were chosen by measurement on tendon-3 reach (8 seeds), tendon-2 circle
+(10 steps), pneumatic-433 circle and spiral and tendon-3 spiral (first 60-100 steps). Every
+simulation starts from the same copied state, so the same state and observation always give the
+same action, whatever the thread count. Near the arms' bending limits the pose can depend roughly
+on the action; there the agent may stop a few mm from a reach target.
+
+Cost on a 2-core CPU: about 0.1 s per control step of tendon-3 (a 1000-step tracking episode in
+about 2 minutes), 0.05 s on pneumatic-433; a control period of tendon-5 is 3x dearer to simulate.
+"""
+
+import copy
+import os
+
+import mujoco
+import numpy as np
+from mujoco import rollout
+
+from softbench import profiles
+from softbench.agents import base
+from softbench.robots import base as robot_base
+from softbench.robots import chain
+
+STATE_SPEC = mujoco.mjtState.mjSTATE_FULLPHYSICS
+ITERATIONS = 6  # Most damped least-squares steps per control step (one simulation each).
+TOLERANCE = 1e-4  # (arm lengths) Residual below which the agent acts without further steps.
+FD_STEP = 1e-2  # (action units) Forward-difference step; smaller steps see the bending limits'
+# roughness and stall reach targets near them.
+DAMPING = 1e-3  # (arm lengths per action unit) Damping of the least-squares steps.
+DAMPING_GROWTH = 10.0  # Factor on the damping after a rejected step with a fresh Jacobian.
+MAX_STEP = 0.5  # (action units) Largest change of an action entry per step.
+EFFORT = 0.1  # (arm lengths per action unit) Pull towards zero action at a large residual ...
+EFFORT_SCALE = 0.1  # (arm lengths) ... scaled by min(1, residual / EFFORT_SCALE).
+ORIENTATION_WEIGHT = 1.0  # (arm lengths per unit of orientation-vector error) 6-entry targets.
+
+
+class ReferenceAgent(base.Agent):
+  """Damped least-squares control through one-period simulations of the bound physics."""
+
+  uses_simulator = True
+
+  def __init__(self, robot: robot_base.SoftArm, seed: int, threads: int | None = None):
+    super().__init__(robot, seed)
+    self._threads = threads or os.cpu_count() or 1
+    self._physics = None
+    self._pool = None
+    self._scored = np.arange(robot.num_modules)
+
+  def bind(self, physics) -> None:
+    self._physics = physics
+    self._model = copy.copy(physics.model.ptr)
+    self._data = [mujoco.MjData(self._model) for _ in range(self._threads)]
+    self._scratch = mujoco.MjData(self._model)
+    self._steps = int(round(self.robot.control_timestep / self._model.opt.timestep))
+    self._action_map = np.array(physics.action_map)
+    self._sites = np.array([self._model.site(chain.tip_site_name(k)).id
+                            for k in range(1, self.robot.num_modules + 1)])
+    self._state = np.empty(mujoco.mj_stateSize(self._model, STATE_SPEC))
+    if self._pool is None:
+      self._pool = rollout.Rollout(nthread=self._threads)
+
+  def reset(self, episode: base.EpisodeInfo) -> None:
+    self._scored = np.array(episode.scored_modules, dtype=int) - 1
+
+  def _features(self, states: np.ndarray, orientation: bool) -> np.ndarray:
+    """(batch, features): scored tip positions over the arm length, then weighted axes."""
+    sites = self._sites[self._scored]
+    features = []
+    for state in states:
+      mujoco.mj_setState(self._model, self._scratch, state, STATE_SPEC)
+      mujoco.mj_kinematics(self._model, self._scratch)
+      feature = [self._scratch.site_xpos[sites].ravel() / self.robot.length]
+      if orientation:
+        axes = self._scratch.site_xmat[sites].reshape(-1, 3, 3)[:, :, 2]
+        feature.append(ORIENTATION_WEIGHT * axes.ravel())
+      features.append(np.concatenate(feature))
+    return np.array(features)
+
+  def _simulate(self, actions: np.ndarray, orientation: bool) -> np.ndarray:
+    """Features after holding each action (batch, action_dim) for one control period."""
+    controls = robot_base.action_to_ctrl(self._action_map, actions)[:, None]
+    states, _ = self._pool.rollout([self._model] * len(actions), self._data, self._state[None],
+                                   controls, nstep=self._steps)
+    return self._features(states[:, -1], orientation)
+
+  def _linearise(self, action: np.ndarray, orientation: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Forward-difference Jacobian (features, action_dim) and the features at ``action``."""
+    steps = np.where(action + FD_STEP <= 1.0, FD_STEP, -FD_STEP)
+    features = self._simulate(np.vstack([action, action + np.diag(steps)]), orientation)
+    return ((features[1:] - features[0]) / steps[:, None]).T, features[0]
+
+  def _step(self, jacobian: np.ndarray, residual: np.ndarray, damping: float,
+            action: np.ndarray) -> np.ndarray:
+    """The next action: argmin |J d - r|^2 + damping^2 |d|^2 + effort^2 |a + d|^2 over the
+    entries not pressed against a bound, shortened to ``MAX_STEP`` and clipped to [-1, 1]."""
+    effort = EFFORT * min(1.0, np.linalg.norm(residual) / EFFORT_SCALE)
+    free = np.ones(len(action), dtype=bool)
+    step = np.zeros(len(action))
+    for _ in range(len(action)):
+      columns = jacobian[:, free]
+      normal = columns.T @ columns + (damping**2 + effort**2) * np.eye(columns.shape[1])
+      step[:] = 0.0
+      step[free] = np.linalg.solve(normal, columns.T @ residual - effort**2 * action[free])
+      pressed = free & (((action >= 1.0) & (step > 0)) | ((action <= -1.0) & (step < 0)))
+      if not pressed.any() or pressed.all():
+        break
+      free &= ~pressed
+    step *= min(1.0, MAX_STEP / max(np.abs(step).max(), 1e-12))
+    return np.clip(action + step, -1.0, 1.0)
+
+  def act(self, observation: dict) -> np.ndarray:
+    if self._physics is None:
+      raise RuntimeError("the reference agent needs bind(physics) before acting")
+    physics = self._physics
+    mujoco.mj_getState(physics.model.ptr, physics.data.ptr, self._state, STATE_SPEC)
+    target = np.asarray(observation["target"], dtype=float)
+    orientation = target.shape[-1] == 6
+    goal = [target[:, :3].ravel() / self.robot.length]
+    if orientation:
+      goal.append(ORIENTATION_WEIGHT * target[:, 3:].ravel())
+    goal = np.concatenate(goal)
+
+    action = np.clip(np.asarray(observation["previous_action"], dtype=float), -1.0, 1.0)
+    jacobian, feature = self._linearise(action, orientation)
+    fresh = True  # Whether the Jacobian is a finite-difference one at ``action``.
+    residual = goal - feature
+    damping = DAMPING
+    for _ in range(ITERATIONS):
+      if np.linalg.norm(residual) < TOLERANCE:
+        break
+      candidate = self._step(jacobian, residual, damping, action)
+      candidate_feature = self._simulate(candidate[None], orientation)[0]
+      if np.linalg.norm(goal - candidate_feature) < np.linalg.norm(residual):
+        step = candidate - action
+        jacobian = jacobian + np.outer(candidate_feature - feature - jacobian @ step,
+                                       step) / (step @ step)
+        action, feature, residual = candidate, candidate_feature, goal - candidate_feature
+        fresh = False
+      elif not fresh:
+        jacobian, _ = self._linearise(action, orientation)
+        fresh = True
+      else:
+        damping *= DAMPING_GROWTH
+    return action
+
+
+def build(robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
+          show_progress: bool = False) -> base.Agent:
+  del profile, show_progress  # Nothing to train: the agent plans on the simulator.
+  return ReferenceAgent(robot, seed)

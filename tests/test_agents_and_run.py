@@ -1,0 +1,116 @@
+"""Every registered agent on a small task set with the tiny profile, and ``softbench run``."""
+
+import json
+import pathlib
+
+import numpy as np
+import pytest
+
+from softbench import agents
+from softbench import cli
+from softbench import evaluation
+from softbench import run
+from softbench import suite
+from softbench.agents import learned
+
+TASKS = (("tendon-2", "circle"), ("pneumatic-433", "spiral"), ("tendon-2", "reach"))
+EPISODE = {"circle": {"length": 4}, "spiral": {"length": 4}, "reach": {"steps": 3}}
+
+
+@pytest.fixture(autouse=True)
+def shared_home(tmp_path_factory, monkeypatch):
+  """One data home for the file: datasets and checkpoints are made once, then reused."""
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path_factory.getbasetemp() / "agents_home"))
+
+
+def episode(agent_name, robot, task, seed=0):
+  agent = agents.make(agent_name, robot, seed, "tiny")
+  env = suite.load(robot, task, seed=seed, **EPISODE[task])
+  return evaluation.run_episode(env, agent, task)
+
+
+@pytest.mark.parametrize("robot,task", TASKS)
+@pytest.mark.parametrize("agent_name", agents.AGENTS)
+class TestEveryAgent:
+
+  def test_actions_are_finite_and_in_bounds(self, agent_name, robot, task):
+    actions = episode(agent_name, robot, task).actions
+    assert actions.shape[1] == suite.load(robot, task, **EPISODE[task]).action_spec().shape[0]
+    assert np.all(np.isfinite(actions)) and np.all(np.abs(actions) <= 1.0)
+
+  def test_deterministic_per_seed(self, agent_name, robot, task):
+    first, second = episode(agent_name, robot, task, 1), episode(agent_name, robot, task, 1)
+    np.testing.assert_array_equal(first.actions, second.actions)
+
+
+@pytest.mark.parametrize("agent_name", [name for name in agents.AGENTS
+                                        if agents.describe(name).learned])
+def test_checkpoint_round_trip_gives_identical_actions(agent_name, tmp_path, monkeypatch):
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
+  trained = episode(agent_name, "tendon-2", "circle")  # Trains, then saves the checkpoint.
+  (checkpoint,) = (tmp_path / learned.CHECKPOINT_FOLDER).glob(f"{agent_name}-*.pt")
+  loaded = episode(agent_name, "tendon-2", "circle")
+  np.testing.assert_array_equal(trained.actions, loaded.actions)
+  checkpoint.write_bytes(checkpoint.read_bytes()[:1000])
+  with pytest.raises(ValueError, match="not a readable checkpoint"):
+    agents.make(agent_name, "tendon-2", 0, "tiny")
+
+
+@pytest.mark.parametrize("mode", learned.ERROR_SOURCES)
+def test_error_sources_differ_after_the_first_step(mode):
+  agent = agents.make("smpl", "tendon-2", 0, "tiny")
+  agent.error_source = mode
+  env = suite.load("tendon-2", "circle", seed=0, length=4)
+  actions = evaluation.run_episode(env, agent, "circle").actions
+  agent.error_source = "open-loop"
+  open_loop = evaluation.run_episode(env, agent, "circle").actions
+  np.testing.assert_array_equal(actions[0], open_loop[0])  # e_0 = 0 in every mode.
+  assert np.array_equal(actions, open_loop) == (mode == "open-loop")
+
+
+def test_softbench_run_end_to_end(tmp_path, capsys):
+  results = tmp_path / "results"
+  extra = tmp_path / "record.json"
+  argv = ["run", "--task", "circle", "--agent", "smpl", "--robot", "tendon-2", "--profile",
+          "tiny", "--results", str(results), "--json", str(extra)]
+  assert cli.main(argv) == 0
+  out = capsys.readouterr().out
+  assert "smpl on circle (tendon-2), profile tiny, eval physics, 2 seed(s)" in out
+  for row in ("module 1", "module 2", "mean", "wall time"):
+    assert row in out
+  (path,) = results.glob("*.json")
+  record = json.loads(path.read_text())
+  assert record == json.loads(extra.read_text())
+  assert (record["agent"], record["robot"], record["task"], record["profile"],
+          record["eval_mode"], record["seeds"]) == ("smpl", "tendon-2", "circle", "tiny",
+                                                    "physics", 2)
+  assert [entry["seed"] for entry in record["per_seed"]] == [0, 1]
+  assert all(len(entry["position_mm"]["per_module"]) == 2 for entry in record["per_seed"])
+  for field in ("softbench_version", "git_commit", "date", "machine", "wall_time_s"):
+    assert field in record
+  per_module, mean = run.summary(record, "position_mm")
+  assert f"{mean.mean:.2f}" in out.splitlines()[-3] + out.splitlines()[-4]
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["--task", "juggle", "--agent", "smpl"], "unknown task"),
+    (["--task", "circle", "--agent", "oracle"], "unknown agent"),
+    (["--task", "circle", "--agent", "zero", "--robot", "tendon-0"], "1 to 10 modules"),
+    (["--task", "circle", "--agent", "zero", "--seeds", "0"], "seeds must be"),
+    (["--task", "circle", "--agent", "zero", "--profile", "huge"], "unknown profile"),
+    (["--task", "circle", "--agent", "zero", "--eval", "dream"], "unknown eval mode"),
+    (["--task", "custom", "--agent", "zero"], "--trajectory"),
+    (["--task", "custom", "--agent", "zero", "--profile", "tiny", "--trajectory",
+      "/nonexistent.npy"], "does not exist"),
+])
+def test_run_refuses_bad_input_with_one_line(argv, message, capsys, tmp_path):
+  assert cli.main(["run", *argv, "--results", str(tmp_path)]) == cli.EXIT_USAGE
+  lines = capsys.readouterr().err.strip().splitlines()
+  assert len(lines) == 1 and message in lines[0]
+  assert not list(pathlib.Path(tmp_path).glob("*.json"))
+
+
+def test_cli_lists_agents(capsys):
+  assert cli.main(["agents"]) == 0
+  out = capsys.readouterr().out
+  assert all(f"\n{name} " in out for name in agents.AGENTS)

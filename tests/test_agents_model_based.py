@@ -1,0 +1,139 @@
+"""Properties of the agents that need no training: ``zero``, ``random`` and the model-based
+``reference``, on every benchmark robot.
+
+Episodes are tiny (3 reach steps, the first 10 steps of a 100-step circle) so that the file runs
+in well under a minute; the properties do not depend on the length.
+"""
+
+import collections
+import functools
+
+import mujoco
+import numpy as np
+import pytest
+
+from softbench import agents
+from softbench import metrics
+from softbench import robots
+from softbench import suite
+from softbench.agents import reference
+
+UNTRAINED_AGENTS = ("zero", "random", "reference")
+REACH_STEPS = 3
+CIRCLE_LENGTH = 100  # Targets of the circle, of which the tests follow the first ...
+TRACKING_STEPS = 10  # ... ones.
+FULL_STATE = mujoco.mjtState.mjSTATE_INTEGRATION  # Physics, controls and applied forces.
+
+Episode = collections.namedtuple("Episode", ["actions", "achieved", "targets", "untouched"])
+
+
+@pytest.fixture(autouse=True)
+def shared_cache(tmp_path_factory, monkeypatch):
+  """One temporary data home for the whole file, so references are simulated once."""
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path_factory.getbasetemp() / "softbench_home"))
+
+
+def full_state(physics) -> np.ndarray:
+  state = np.empty(mujoco.mj_stateSize(physics.model.ptr, FULL_STATE))
+  mujoco.mj_getState(physics.model.ptr, physics.data.ptr, state, FULL_STATE)
+  return state
+
+
+def run_episode(agent: agents.Agent, env, task: str, max_steps: int | None = None) -> Episode:
+  """One episode as the evaluation runs it, or its first ``max_steps`` steps: actions
+  (T, action_dim), the scored modules' achieved poses (T, scored, 6) and targets
+  (T, scored, 6 or 3), and whether every ``act`` left the environment's physics exactly as it
+  found it."""
+  time_step = env.reset()
+  if agent.uses_simulator:
+    agent.bind(env.physics)
+  scored = env.task.scored_modules()
+  agent.reset(agents.EpisodeInfo(task, scored))
+  actions, achieved, targets, untouched = [], [], [], True
+  while not time_step.last() and len(actions) != max_steps:
+    before = full_state(env.physics)
+    action = agent.act(time_step.observation)
+    untouched &= np.array_equal(full_state(env.physics), before)
+    actions.append(np.array(action))
+    targets.append(time_step.observation["target"])
+    time_step = env.step(action)
+    achieved.append(time_step.observation["poses"][np.array(scored) - 1])
+  return Episode(np.array(actions), np.array(achieved), np.array(targets), untouched)
+
+
+@functools.lru_cache(maxsize=None)
+def reach_episode(name: str, robot: str, seed: int = 0) -> Episode:
+  env = suite.load(robot, "reach", seed=seed, steps=REACH_STEPS)
+  return run_episode(agents.make(name, robot, seed), env, "reach")
+
+
+def tip_error_percent(name: str, robot: str, task: str, max_steps: int | None = None,
+                      **options) -> float:
+  """Mean normalised tip error (%) of agent ``name`` over (the first ``max_steps`` steps of) an
+  episode of ``task``."""
+  env = suite.load(robot, task, seed=0, **options)
+  episode = run_episode(agents.make(name, robot), env, task, max_steps)
+  score = metrics.score(episode.achieved, episode.targets, robots.make(robot).length)
+  return score.average("normalised_tip_percent").mean
+
+
+@pytest.mark.parametrize("robot", robots.BENCHMARK_ROBOTS)
+@pytest.mark.parametrize("name", UNTRAINED_AGENTS)
+class TestEveryAgent:
+
+  def test_actions_are_finite_and_in_bounds(self, name, robot):
+    actions = reach_episode(name, robot).actions
+    assert actions.shape == (REACH_STEPS, robots.make(robot).action_dim)
+    assert np.all(np.isfinite(actions))
+    assert np.all(np.abs(actions) <= 1.0)
+
+  def test_same_seed_same_actions(self, name, robot):
+    env = suite.load(robot, "reach", seed=0, steps=REACH_STEPS)
+    again = run_episode(agents.make(name, robot, 0), env, "reach")
+    np.testing.assert_array_equal(again.actions, reach_episode(name, robot).actions)
+
+  def test_never_changes_the_environment_while_acting(self, name, robot):
+    assert reach_episode(name, robot).untouched
+
+
+def test_zero_agent_acts_zeros():
+  np.testing.assert_array_equal(reach_episode("zero", "tendon-3").actions, 0.0)
+
+
+def test_random_agent_repeats_per_episode_and_depends_on_seed():
+  agent = agents.make("random", "tendon-2", seed=3)
+  env = suite.load("tendon-2", "reach", seed=0, steps=REACH_STEPS)
+  first = run_episode(agent, env, "reach").actions
+  np.testing.assert_array_equal(run_episode(agent, env, "reach").actions, first)
+  other = run_episode(agents.make("random", "tendon-2", seed=4), env, "reach").actions
+  assert not np.array_equal(first, other)
+  assert len(np.unique(first)) == first.size  # Not a constant action.
+
+
+def test_reference_agent_needs_the_physics():
+  agent = agents.make("reference", "tendon-1")
+  assert agent.uses_simulator
+  observation = suite.load("tendon-1", "reach", seed=0, steps=1).reset().observation
+  with pytest.raises(RuntimeError, match="bind"):
+    agent.act(observation)
+
+
+def test_reference_agent_does_not_depend_on_the_thread_count():
+  env = suite.load("tendon-3", "reach", seed=0, steps=REACH_STEPS)
+  agent = reference.ReferenceAgent(robots.make("tendon-3"), 0, threads=1)
+  single = run_episode(agent, env, "reach")
+  np.testing.assert_array_equal(single.actions, reach_episode("reference", "tendon-3").actions)
+
+
+@pytest.mark.parametrize("robot,task,options", [
+    # Measured (mean normalised tip error, zero agent -> reference agent): tendon-2 circle
+    # 21.2 % -> 0.0003 %, pneumatic-433 circle 15.6 % -> 0.012 %, tendon-3 reach (module 2)
+    # 29.3 % -> 0.002 %.
+    ("tendon-2", "circle", {"length": CIRCLE_LENGTH, "max_steps": TRACKING_STEPS}),
+    ("pneumatic-433", "circle", {"length": CIRCLE_LENGTH, "max_steps": TRACKING_STEPS}),
+    ("tendon-3", "reach", {"steps": REACH_STEPS}),
+])
+def test_reference_agent_tracks_far_better_than_zero(robot, task, options):
+  reference = tip_error_percent("reference", robot, task, **options)
+  zero = tip_error_percent("zero", robot, task, **options)
+  assert reference < zero / 10, (reference, zero)
