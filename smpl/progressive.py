@@ -89,9 +89,8 @@ class ProgressiveLSTM(InverseModel):
     single tensor for the chosen column from which every earlier column reads the leading features
     it needs, zero-padded on the right if it reads more. A shared tensor suits Exp1S: with inputs
     [target, error, previous action of modules 1..k], column j < k reads [target, error, previous
-    action of modules 1..j]. Padding suits Exp2R, where module 1 (4 bellows) is wider than
-    modules 2 and 3 (3 bellows): every column reads the input of the module being controlled, as
-    in a standard progressive network, and the missing previous-action entry reads 0.
+    action of modules 1..j]. One tensor per column suits Exp2S/Exp2R, where column k reads
+    module k's own target, error and previous action (`step_columns` runs them together).
     """
 
     def __init__(self, hidden_size: int = HIDDEN_SIZE, num_lstm_layers: int = LSTM_LAYERS) -> None:
@@ -174,10 +173,25 @@ class ProgressiveLSTM(InverseModel):
             raise ValueError(
                 f"state holds {len(state)} columns, column {column} needs {column + 1}"
             )
-        column_inputs = self._route(inputs, column)
-        outputs, new_state = self._propagate(column_inputs, state, _run_step)
-        action = outputs[-1]
+        actions, new_state = self.step_columns(inputs, state, column)
+        action = actions[-1]
         return InverseStep(action, action.new_zeros(()), new_state)
+
+    def step_columns(
+        self,
+        inputs: Tensor | Sequence[Tensor],
+        state: tuple[ColumnState, ...],
+        column: int = -1,
+    ) -> tuple[list[Tensor], tuple[ColumnState, ...]]:
+        """One control step of columns 0..`column` at once: every column's output and the new
+        state. With one input per column (each module's own target, error and previous action),
+        this is the distributed controller of Exp2S/Exp2R acting on the whole arm."""
+        column = self._column_index(column)
+        if len(state) != column + 1:
+            raise ValueError(
+                f"state holds {len(state)} columns, column {column} needs {column + 1}"
+            )
+        return self._propagate(self._route(inputs, column), state, _run_step)
 
     def _propagate(
         self,

@@ -22,6 +22,7 @@ forward model, if given, still predicts poses for scoring.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import torch
@@ -29,7 +30,8 @@ from torch import Tensor
 
 from smpl.forward_model import ForwardModel
 from smpl.inverse import InverseModel
-from smpl.windows import BabblingWindows, inverse_input_size, inverse_inputs
+from smpl.progressive import ProgressiveLSTM
+from smpl.windows import BabblingWindows, ModuleWindows, inverse_input_size, inverse_inputs
 
 
 @dataclass(frozen=True)
@@ -93,3 +95,46 @@ def rollout(
         predicted_poses=torch.stack(predicted_poses, dim=1) if predicted_poses else None,
         aux_loss=torch.stack(aux_losses).mean(),
     )
+
+
+def joint_rollout(
+    network: ProgressiveLSTM,
+    windows: ModuleWindows,
+    forward_models: Sequence[ForwardModel],
+    feed_back_error: bool = True,
+) -> list[Rollout]:
+    """Runs columns 0..len(windows.modules)-1 together, column j on module j's own inputs.
+
+    The same loop as `rollout`, for every module at once: at step t column j reads
+    [x^j_{t+1}, e^j_t, a'^j_{t-1}], one `step_columns` call gives every column's action, and
+    module j's forward model turns a'^j_t into the next error e^j_{t+1}. Through the lateral
+    connections a distal column sees the proximal columns' features of their own targets and
+    errors, which its module's pose depends on.
+    """
+    modules = windows.modules
+    if len(forward_models) != len(modules):
+        raise ValueError(f"{len(modules)} modules need as many forward models, got "
+                         f"{len(forward_models)}")
+    batch_size = len(windows)
+    state = network.initial_state(batch_size, len(modules) - 1)
+    forward_states = [model.initial_state(batch_size) for model in forward_models]
+    errors = [w.poses.new_zeros(batch_size, w.pose_size) for w in modules]
+    previous = [w.actions.new_zeros(batch_size, w.action_size) for w in modules]
+    history = [([], [], []) for _ in modules]  # actions, errors, predicted poses
+    for t in range(windows.modules[0].steps):
+        inputs = [inverse_inputs(w.next_poses[:, t], error, action)
+                  for w, error, action in zip(modules, errors, previous)]
+        actions, state = network.step_columns(inputs, state, len(modules) - 1)
+        for j, (w, model, action) in enumerate(zip(modules, forward_models, actions)):
+            predicted, forward_states[j] = model.step(
+                w.previous_poses[:, t], w.current_poses[:, t], w.actuation(action, t),
+                forward_states[j])
+            history[j][0].append(action)
+            history[j][1].append(errors[j])
+            history[j][2].append(predicted)
+            if feed_back_error:
+                errors[j] = w.next_poses[:, t] - predicted
+        previous = actions
+    zero = modules[0].actions.new_zeros(())
+    return [Rollout(torch.stack(a, 1), torch.stack(e, 1), torch.stack(p, 1), zero)
+            for a, e, p in history]

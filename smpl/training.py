@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 import time
 import warnings
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
@@ -24,8 +24,9 @@ from torch import Tensor, nn
 
 from smpl.forward_model import ForwardModel
 from smpl.inverse import InverseModel
-from smpl.rollout import rollout
-from smpl.windows import BabblingWindows
+from smpl.progressive import ProgressiveLSTM
+from smpl.rollout import joint_rollout, rollout
+from smpl.windows import BabblingWindows, ModuleWindows
 
 LEARNING_RATE = 1e-3
 """Adam step size (paper, forward model and SMPL)."""
@@ -305,6 +306,34 @@ def train_inverse_model(
         device,
         on_epoch_end,
     )
+
+
+def train_column_jointly(
+    network: ProgressiveLSTM,
+    forward_models: Sequence[ForwardModel],
+    train: ModuleWindows,
+    validation: ModuleWindows,
+    config: InverseTrainingConfig = InverseTrainingConfig(),
+    device: torch.device | None = None,
+    on_epoch_end: Callable[[EpochReport], None] | None = None,
+) -> TrainingResult:
+    """Trains the last of columns 0..M-1 (M = modules in `train`) of a distributed controller,
+    all columns acting together on their own modules (`smpl.rollout.joint_rollout`); the loss
+    is the action MSE of that column's module. Earlier columns must be trained and frozen."""
+    column = len(train.modules) - 1
+    if any(parameter.requires_grad for parameter in network.columns[:column].parameters()):
+        raise ValueError("the earlier columns must be frozen before the next one trains")
+    if not all(model.is_frozen for model in forward_models):
+        raise ValueError("the forward models must be trained and frozen before the inverse model")
+    device = device if device is not None else default_device()
+    for model in forward_models:
+        model.to(device).eval()
+
+    def loss(windows: ModuleWindows) -> Tensor:
+        result = joint_rollout(network, windows, forward_models, config.feed_back_error)[column]
+        return nn.functional.mse_loss(result.actions, windows.modules[column].actions)
+
+    return fit(network, loss, train, validation, config, device, on_epoch_end)
 
 
 def _train_epoch(

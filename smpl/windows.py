@@ -158,3 +158,33 @@ class BabblingWindows:
         return BabblingWindows(
             self.poses.to(device), self.actions.to(device), self.preceding_actions.to(device)
         )
+
+
+@dataclass(frozen=True)
+class ModuleWindows:
+    """Time-aligned windows of every module of one arm (window i of each module covers the same
+    control steps), for training a distributed controller's columns together.
+
+    It offers what `smpl.training.fit` uses of BabblingWindows: `len`, `subset`, `to`, `actions`.
+    """
+
+    modules: tuple[BabblingWindows, ...]
+
+    def __post_init__(self) -> None:
+        counts = {(len(windows), windows.steps) for windows in self.modules}
+        if len(counts) != 1:
+            raise ValueError(f"module windows are not aligned: (windows, steps) {sorted(counts)}")
+
+    def __len__(self) -> int:
+        return len(self.modules[0])
+
+    @property
+    def actions(self) -> Tensor:
+        """The first module's actions (for the device and the count)."""
+        return self.modules[0].actions
+
+    def subset(self, indices: Tensor) -> ModuleWindows:
+        return ModuleWindows(tuple(windows.subset(indices) for windows in self.modules))
+
+    def to(self, device: torch.device) -> ModuleWindows:
+        return ModuleWindows(tuple(windows.to(device) for windows in self.modules))

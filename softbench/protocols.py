@@ -7,8 +7,10 @@
   reads the preceding modules' actuation.
 
 Every column has its own dataset view, normalisation (fitted on its training split) and frozen
-forward model; ``smpl.protocol.train_progressively`` adds and trains the columns in order and
-scores every column seen so far after each stage, which gives the forgetting matrix.
+forward model. Columns are added and trained in order, and after each stage every column seen so
+far is scored on its test windows, which gives the forgetting matrix. In Exp1S each column learns
+alone (``smpl.protocol.train_progressively``); in Exp2S/Exp2R the columns act together, column k
+on module k's own inputs (``smpl.training.train_column_jointly``), as the ``smpl`` agent does.
 """
 
 import dataclasses
@@ -19,7 +21,9 @@ import torch
 from smpl import forward_model as smpl_forward
 from smpl import progressive
 from smpl import protocol as smpl_protocol
+from smpl import rollout as smpl_rollout
 from smpl import training
+from smpl import windows as smpl_windows
 from softbench import data
 from softbench import robots
 
@@ -106,6 +110,35 @@ def run(protocol: Protocol, samples: int = data.DEFAULT_SAMPLES, seed: int = 0,
   columns = [prepare_column(arm, view, datasets[arm.name], forward_config, device)
              for arm, view in protocol.column_views()]
   network = progressive.ProgressiveLSTM()
-  outcome = smpl_protocol.train_progressively(network, [column.task for column in columns],
-                                              inverse_config, device)
+  if protocol.per_module:
+    outcome = _train_jointly(network, columns, inverse_config, device)
+  else:
+    outcome = smpl_protocol.train_progressively(network, [column.task for column in columns],
+                                                inverse_config, device)
   return ProtocolResult(protocol, network, columns, outcome)
+
+
+def _train_jointly(network: progressive.ProgressiveLSTM, columns: list[PreparedColumn],
+                   config: training.InverseTrainingConfig, device: torch.device | None
+                   ) -> smpl_protocol.ProgressiveRun:
+  """Adds and trains one column per module, all columns acting together; scores after each."""
+  device = device if device is not None else training.default_device()
+  outcome = smpl_protocol.ProgressiveRun(training=[], scores=[])
+  for stage, column in enumerate(columns):
+    seen = columns[:stage + 1]
+    split = lambda name: smpl_windows.ModuleWindows(tuple(getattr(c.windows, name) for c in seen))
+    train = column.windows.train
+    with training.seeded(config.seed + network.num_columns, torch.device("cpu")):
+      network.add_column(smpl_windows.inverse_input_size(train.pose_size, train.action_size),
+                         train.action_size)
+    forwards = [c.forward_model for c in seen]
+    outcome.training.append(training.train_column_jointly(
+        network, forwards, split("train"), split("validation"), config, device))
+    test = split("test").to(device)
+    with torch.no_grad(), training.limited_cpu_threads(config.cpu_threads, device):
+      rollouts = smpl_rollout.joint_rollout(network.eval(), test, forwards)
+    outcome.scores.append([smpl_protocol.ColumnScore(
+        torch.nn.functional.mse_loss(result.actions, windows.actions).item(),
+        torch.nn.functional.mse_loss(result.predicted_poses, windows.next_poses).item())
+        for result, windows in zip(rollouts, test.modules)])
+  return outcome

@@ -42,6 +42,8 @@ from softbench.robots import base as robot_base
 ERROR_SOURCES = ("physics", "model", "open-loop")
 CHECKPOINT_FOLDER = "checkpoints"
 DATA_SEED = 0  # Every agent and seed learns from the same babbling dataset.
+TRAINING_VERSION = 2  # Bump when training changes, so cached checkpoints are not reused. 2: SMPL
+# columns train and act together, each on its own module's inputs.
 
 ModelFactory = Callable[[int, int], InverseModel]  # (input_size, action_size) -> model
 
@@ -59,6 +61,7 @@ class TrainedConfig:
   max_epochs: int
   patience: int
   compile: bool
+  training_version: int = TRAINING_VERSION
 
   @property
   def key(self) -> str:
@@ -79,13 +82,19 @@ class Controller:
 
 
 class LearnedAgent(base.Agent):
-  """Acts with trained controllers; see the module docstring."""
+  """Acts with trained controllers; see the module docstring.
+
+  With ``columns`` (SMPL), the controllers are the columns of one progressive network and act
+  together: one ``step_columns`` call, column k on module k's own inputs.
+  """
 
   def __init__(self, robot: robot_base.SoftArm, seed: int, controllers: list[Controller],
-               error_source: str = "physics"):
+               error_source: str = "physics",
+               columns: progressive.ProgressiveLSTM | None = None):
     super().__init__(robot, seed)
     self.controllers = controllers
     self.error_source = error_source
+    self.columns = columns
     self._reset_memory()
 
   def _reset_memory(self) -> None:
@@ -104,6 +113,8 @@ class LearnedAgent(base.Agent):
     for controller in self.controllers:
       controller.state = controller.inverse.initial_state(1)
       controller.forward_state = controller.forward.initial_state(1)
+    if self.columns is not None:
+      self._columns_state = self.columns.initial_state(1, len(self.controllers) - 1)
 
   def _full_target(self, target: np.ndarray) -> np.ndarray:
     full = self._start_poses.copy()
@@ -118,17 +129,29 @@ class LearnedAgent(base.Agent):
     target = self._full_target(np.asarray(observation["target"], dtype=float))
     action = np.zeros(self.robot.action_dim)
     with torch.no_grad():
-      for controller in self.controllers:
-        action[list(controller.view.action_indices)] = self._controller_action(
-            controller, target, poses)
+      inputs = [self._controller_inputs(controller, target, poses)
+                for controller in self.controllers]
+      if self.columns is not None:
+        outputs, self._columns_state = self.columns.step_columns(
+            inputs, self._columns_state, len(self.controllers) - 1)
+      else:
+        outputs = []
+        for controller, controller_inputs in zip(self.controllers, inputs):
+          step = controller.inverse.step(controller_inputs, controller.state)
+          controller.state = step.state
+          outputs.append(step.action)
+      for controller, output in zip(self.controllers, outputs):
+        action[list(controller.view.action_indices)] = controller.normalisation.actions.denormalise(
+            output[0].numpy().astype(float))
     action = np.clip(action, -1.0, 1.0)
     self._previous_target = target
     self._poses_before, self._previous_poses = self._previous_poses, poses
     self._previous_action = action
     return action
 
-  def _controller_action(self, controller: Controller, target: np.ndarray,
-                         poses: np.ndarray) -> np.ndarray:
+  def _controller_inputs(self, controller: Controller, target: np.ndarray,
+                         poses: np.ndarray) -> torch.Tensor:
+    """The controller's normalised input [x*_{t+1}, e_t, a_{t-1}], (1, input_size)."""
     view, scale = controller.view, controller.normalisation
     as_tensor = lambda values: torch.as_tensor(values, dtype=torch.float32)[None]
     pick = lambda full: scale.poses.normalise(view.select(full, self._previous_action)[0])
@@ -146,11 +169,8 @@ class LearnedAgent(base.Agent):
           as_tensor(pick(self._poses_before)), as_tensor(pick(self._previous_poses)),
           as_tensor(actuation), controller.forward_state)
       error = pick(self._previous_target) - predicted[0].numpy()
-    inputs = smpl_windows.inverse_inputs(as_tensor(pick(target)), as_tensor(error),
-                                         as_tensor(previous_action))
-    step = controller.inverse.step(inputs, controller.state)
-    controller.state = step.state
-    return scale.actions.denormalise(step.action[0].numpy().astype(float))
+    return smpl_windows.inverse_inputs(as_tensor(pick(target)), as_tensor(error),
+                                       as_tensor(previous_action))
 
 
 def _training_configs(seed: int, profile: profiles.Profile
@@ -200,20 +220,26 @@ def _train(name: str, robot: robot_base.SoftArm, views: list[data.View], seed: i
   device = training.default_device()
   with training.seeded(seed, torch.device("cpu")):
     inverse, forwards = _models(views, per_module, make_model)
-  normalisations = []
+  prepared = []
   for index, view in enumerate(views):
     label = f"{name} {robot.name} seed {seed} {view.name}"
     with _progress_bar(f"forward {label}", profile.max_epochs, show) as bar:
-      prepared = protocols.prepare_column(robot, view, dataset, forward_config, device, bar)
-    forwards[index] = prepared.forward_model
-    normalisations.append(prepared.windows.normalisation)
-    if per_module:  # Column by column: the earlier ones are trained and stay frozen.
-      inverse.columns.requires_grad_(False)
-      inverse.columns[index].requires_grad_(True)
+      prepared.append(protocols.prepare_column(robot, view, dataset, forward_config, device, bar))
+    forwards[index] = prepared[-1].forward_model
     with _progress_bar(f"inverse {label}", profile.max_epochs, show) as bar:
-      training.train_inverse_model(_inverse_of(inverse, index, per_module),
-                                   prepared.forward_model, prepared.windows.train,
-                                   prepared.windows.validation, inverse_config, device, bar)
+      if per_module:  # Column by column, all acting together; the earlier ones stay frozen.
+        inverse.columns.requires_grad_(False)
+        inverse.columns[index].requires_grad_(True)
+        training.train_column_jointly(
+            inverse, forwards[:index + 1],
+            smpl_windows.ModuleWindows(tuple(column.windows.train for column in prepared)),
+            smpl_windows.ModuleWindows(tuple(column.windows.validation for column in prepared)),
+            inverse_config, device, bar)
+      else:
+        training.train_inverse_model(inverse, prepared[-1].forward_model,
+                                     prepared[-1].windows.train, prepared[-1].windows.validation,
+                                     inverse_config, device, bar)
+  normalisations = [column.windows.normalisation for column in prepared]
   inverse.requires_grad_(False)
   return inverse, forwards, normalisations
 
@@ -244,4 +270,4 @@ def build_agent(name: str, robot: robot_base.SoftArm, seed: int, profile: profil
   controllers = [Controller(view, _inverse_of(inverse, index, per_module), forward.eval(), scale)
                  for index, (view, forward, scale) in enumerate(zip(views, forwards,
                                                                      normalisations))]
-  return LearnedAgent(robot, seed, controllers)
+  return LearnedAgent(robot, seed, controllers, columns=inverse if per_module else None)
