@@ -6,7 +6,6 @@ errors per module are averaged over its steps, and the table gives their mean an
 deviation over seeds. Every run writes a result record with full provenance.
 """
 
-import concurrent.futures
 import dataclasses
 import datetime
 import json
@@ -14,6 +13,7 @@ import multiprocessing
 import os
 import pathlib
 import platform
+import signal
 import subprocess
 import time
 
@@ -38,6 +38,7 @@ PAPER_ROBOT = {"babbling": "tendon-3", "circle": "tendon-3", "rectangle": "tendo
 arm), the default of ``--robot``."""
 METRICS = (("position_mm", "position (mm)"), ("orientation_deg", "orientation (deg)"),
            ("normalised_tip_percent", "tip error (%)"))
+_POLL_SECONDS = 0.2  # (s) How often the parent looks at its worker processes.
 RECORD_FORMAT = "softbench-result"
 RECORD_VERSION = 1
 
@@ -129,19 +130,34 @@ def _run_seed(run: RunSettings, seed: int, show_progress: bool) -> tuple[dict, t
            **_seed_scores(episode.score(arm.length))}, episode.scored_modules)
 
 
+def _ignore_interrupts() -> None:
+  """Worker initialiser: Ctrl-C reaches the parent only, which stops the workers itself."""
+  signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 def _parallel_seeds(run: RunSettings, workers: int) -> list[tuple[dict, tuple[int, ...]]]:
-  """Seeds in ``workers`` processes (one torch and MuJoCo thread each), with one progress bar."""
-  context = multiprocessing.get_context("spawn")
+  """Seeds in ``workers`` processes (one torch and MuJoCo thread each), with one progress bar.
+
+  On Ctrl-C the workers are terminated; seeds whose checkpoints were written are reused by the
+  next run."""
   progress = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                       TimeElapsedColumn())
-  with progress, concurrent.futures.ProcessPoolExecutor(workers, mp_context=context) as pool:
-    bar = progress.add_task(f"{run.agent} on {run.task}: seeds ({workers} processes)",
-                            total=run.seeds)
-    futures = [pool.submit(_run_seed, run, seed, False) for seed in range(run.seeds)]
-    for future in concurrent.futures.as_completed(futures):
-      future.result()
-      progress.advance(bar)
-    return [future.result() for future in futures]
+  pool = multiprocessing.get_context("spawn").Pool(workers, initializer=_ignore_interrupts)
+  try:
+    with progress:
+      bar = progress.add_task(f"{run.agent} on {run.task}: seeds ({workers} processes)",
+                              total=run.seeds)
+      pending = [pool.apply_async(_run_seed, (run, seed, False)) for seed in range(run.seeds)]
+      while not all(result.ready() for result in pending):
+        time.sleep(_POLL_SECONDS)
+        progress.update(bar, completed=sum(result.ready() for result in pending))
+      outcomes = [result.get() for result in pending]  # Re-raises a worker's error.
+      progress.update(bar, completed=run.seeds)
+    pool.close()
+    return outcomes
+  finally:
+    pool.terminate()
+    pool.join()
 
 
 def execute(run: RunSettings, show_progress: bool = True, workers: int | None = None) -> dict:
