@@ -31,6 +31,7 @@ from softbench import robots
 from softbench import storage
 from softbench import suite
 from softbench.agents import learned
+from softbench.data import dataset
 
 PAPER_ROBOT = {"babbling": "tendon-3", "circle": "tendon-3", "rectangle": "tendon-3",
                "spiral": "tendon-3", "custom": "tendon-3", "reach": "pneumatic-433"}
@@ -69,8 +70,7 @@ def settings(task: str, agent: str, robot: str | None = None, seeds: int | None 
   robot = robot or PAPER_ROBOT[task]
   robots.make(robot)
   seeds = chosen.seeds if seeds is None else seeds
-  if isinstance(seeds, bool) or not isinstance(seeds, int) or seeds < 1:
-    raise ValueError(f"seeds must be a positive integer, got {seeds!r}")
+  dataset.check_count("seeds", seeds)
   if eval_mode not in learned.ERROR_SOURCES:
     raise ValueError(f"unknown eval mode {eval_mode!r}; choose one of "
                      f"{', '.join(learned.ERROR_SOURCES)}")

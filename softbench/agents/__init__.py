@@ -10,6 +10,7 @@ from typing import Callable
 
 from softbench import profiles
 from softbench import robots
+from softbench.data import seeding
 from softbench.agents.base import Agent
 from softbench.agents.base import EpisodeInfo
 
@@ -49,8 +50,7 @@ def make(name: str, robot: str | robots.SoftArm, seed: int = 0,
   entry = describe(name)
   arm = robots.make(robot) if isinstance(robot, str) else robot
   profile = profiles.get(profile) if isinstance(profile, str) else profile
-  if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-    raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
+  seeding.check_seed(seed)
   build: Callable[..., Agent] = importlib.import_module(entry.module).build
   return build(arm, seed, profile, show_progress)
 

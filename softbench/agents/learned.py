@@ -71,30 +71,28 @@ class TrainedConfig:
 
 @dataclasses.dataclass
 class Controller:
-  """One view's inverse model, forward model and normalisation, with its running state."""
+  """One view's forward model and normalisation, with the forward model's running state."""
 
   view: data.View
-  inverse: InverseModel
   forward: smpl_forward.ForwardModel
   normalisation: data.Normalisation
-  state: object = None
   forward_state: object = None
 
 
 class LearnedAgent(base.Agent):
   """Acts with trained controllers; see the module docstring.
 
-  With ``columns`` (SMPL), the controllers are the columns of one progressive network and act
-  together: one ``step_columns`` call, column k on module k's own inputs.
+  ``inverse`` is one model for all controllers: a centralised baseline (one controller), or SMPL's
+  progressive network, whose columns act together (``step_columns``), column k on module k's own
+  inputs.
   """
 
-  def __init__(self, robot: robot_base.SoftArm, seed: int, controllers: list[Controller],
-               error_source: str = "physics",
-               columns: progressive.ProgressiveLSTM | None = None):
+  def __init__(self, robot: robot_base.SoftArm, seed: int, inverse: InverseModel,
+               controllers: list[Controller], error_source: str = "physics"):
     super().__init__(robot, seed)
+    self.inverse = inverse
     self.controllers = controllers
     self.error_source = error_source
-    self.columns = columns
     self._reset_memory()
 
   def _reset_memory(self) -> None:
@@ -111,10 +109,8 @@ class LearnedAgent(base.Agent):
     self._scored = np.array(episode.scored_modules) - 1
     self._reset_memory()
     for controller in self.controllers:
-      controller.state = controller.inverse.initial_state(1)
       controller.forward_state = controller.forward.initial_state(1)
-    if self.columns is not None:
-      self._columns_state = self.columns.initial_state(1, len(self.controllers) - 1)
+    self._inverse_state = self.inverse.initial_state(1)
 
   def _full_target(self, target: np.ndarray) -> np.ndarray:
     full = self._start_poses.copy()
@@ -131,15 +127,12 @@ class LearnedAgent(base.Agent):
     with torch.no_grad():
       inputs = [self._controller_inputs(controller, target, poses)
                 for controller in self.controllers]
-      if self.columns is not None:
-        outputs, self._columns_state = self.columns.step_columns(
-            inputs, self._columns_state, len(self.controllers) - 1)
+      if isinstance(self.inverse, progressive.ProgressiveLSTM):
+        outputs, self._inverse_state = self.inverse.step_columns(inputs, self._inverse_state)
       else:
-        outputs = []
-        for controller, controller_inputs in zip(self.controllers, inputs):
-          step = controller.inverse.step(controller_inputs, controller.state)
-          controller.state = step.state
-          outputs.append(step.action)
+        (single,) = inputs
+        step = self.inverse.step(single, self._inverse_state)
+        outputs, self._inverse_state = [step.action], step.state
       for controller, output in zip(self.controllers, outputs):
         action[list(controller.view.action_indices)] = controller.normalisation.actions.denormalise(
             output[0].numpy().astype(float))
@@ -184,27 +177,20 @@ def _input_size(view: data.View) -> int:
   return smpl_windows.inverse_input_size(view.pose_size, view.action_size)
 
 
-def _models(views: list[data.View], per_module: bool, make_model: ModelFactory
-            ) -> tuple[InverseModel, list[smpl_forward.ForwardModel]]:
-  """Untrained models of the right sizes (the inverse network, and one forward model per view)."""
+def _inverse_model(views: list[data.View], per_module: bool,
+                   make_model: ModelFactory) -> InverseModel:
+  """An untrained inverse model for the views: a column per module, or one centralised model."""
   if per_module:
     inverse = progressive.ProgressiveLSTM()
     for view in views:
       inverse.add_column(_input_size(view), view.action_size)
-  else:
-    (view,) = views
-    inverse = make_model(_input_size(view), view.action_size)
-  forwards = [smpl_forward.ForwardModel(view.preceding_action_size + view.action_size,
-                                        view.pose_size) for view in views]
-  return inverse, forwards
+    return inverse
+  (view,) = views
+  return make_model(_input_size(view), view.action_size)
 
 
 def _bundle(inverse: InverseModel, forwards: list[smpl_forward.ForwardModel]) -> torch.nn.Module:
   return torch.nn.ModuleDict({"inverse": inverse, "forward_models": torch.nn.ModuleList(forwards)})
-
-
-def _inverse_of(inverse: InverseModel, index: int, per_module: bool) -> InverseModel:
-  return inverse.column_model(index) if per_module else inverse
 
 
 def _progress_bar(label: str, epochs: int, show: bool):
@@ -219,19 +205,19 @@ def _train(name: str, robot: robot_base.SoftArm, views: list[data.View], seed: i
   forward_config, inverse_config = _training_configs(seed, profile)
   device = training.default_device()
   with training.seeded(seed, torch.device("cpu")):
-    inverse, forwards = _models(views, per_module, make_model)
+    inverse = _inverse_model(views, per_module, make_model)
   prepared = []
   for index, view in enumerate(views):
     label = f"{name} {robot.name} seed {seed} {view.name}"
     with _progress_bar(f"forward {label}", profile.max_epochs, show) as bar:
       prepared.append(protocols.prepare_column(robot, view, dataset, forward_config, device, bar))
-    forwards[index] = prepared[-1].forward_model
+    forwards = [column.forward_model for column in prepared]
     with _progress_bar(f"inverse {label}", profile.max_epochs, show) as bar:
       if per_module:  # Column by column, all acting together; the earlier ones stay frozen.
         inverse.columns.requires_grad_(False)
         inverse.columns[index].requires_grad_(True)
         training.train_column_jointly(
-            inverse, forwards[:index + 1],
+            inverse, forwards,
             smpl_windows.ModuleWindows(tuple(column.windows.train for column in prepared)),
             smpl_windows.ModuleWindows(tuple(column.windows.validation for column in prepared)),
             inverse_config, device, bar)
@@ -255,7 +241,9 @@ def build_agent(name: str, robot: robot_base.SoftArm, seed: int, profile: profil
                          profile.max_epochs, profile.patience, profile.compile)
   path = storage.softbench_home() / CHECKPOINT_FOLDER / f"{config.key}.pt"
   if path.exists():
-    inverse, forwards = _models(views, per_module, make_model)
+    inverse = _inverse_model(views, per_module, make_model)
+    forwards = [smpl_forward.ForwardModel(view.preceding_action_size + view.action_size,
+                                          view.pose_size) for view in views]
     arrays = checkpoint.load_checkpoint(path, _bundle(inverse, forwards), config)
     normalisations = [data.Normalisation.from_arrays(
         {key.removeprefix(f"{view.name}/"): value for key, value in arrays.items()
@@ -267,7 +255,6 @@ def build_agent(name: str, robot: robot_base.SoftArm, seed: int, profile: profil
               for key, value in scale.to_arrays().items()}
     checkpoint.save_checkpoint(path, _bundle(inverse, forwards), config, arrays)
   inverse.eval()
-  controllers = [Controller(view, _inverse_of(inverse, index, per_module), forward.eval(), scale)
-                 for index, (view, forward, scale) in enumerate(zip(views, forwards,
-                                                                     normalisations))]
-  return LearnedAgent(robot, seed, controllers, columns=inverse if per_module else None)
+  controllers = [Controller(view, forward.eval(), scale)
+                 for view, forward, scale in zip(views, forwards, normalisations)]
+  return LearnedAgent(robot, seed, inverse, controllers)
