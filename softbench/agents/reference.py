@@ -33,14 +33,12 @@ import os
 
 import mujoco
 import numpy as np
-from mujoco import rollout
 
 from softbench import profiles
 from softbench.agents import base
 from softbench.robots import base as robot_base
-from softbench.robots import chain
+from softbench.robots import recorder
 
-STATE_SPEC = mujoco.mjtState.mjSTATE_FULLPHYSICS
 ITERATIONS = 6  # Most damped least-squares steps per control step (one simulation each).
 TOLERANCE = 1e-4  # (arm lengths) Residual below which the agent acts without further steps.
 FD_STEP = 1e-2  # (action units) Forward-difference step; smaller steps see the bending limits'
@@ -62,45 +60,27 @@ class ReferenceAgent(base.Agent):
     super().__init__(robot, seed)
     self._threads = threads or os.cpu_count() or 1
     self._physics = None
-    self._pool = None
     self._scored = np.arange(robot.num_modules)
 
   def bind(self, physics) -> None:
     self._physics = physics
-    self._model = copy.copy(physics.model.ptr)
-    self._data = [mujoco.MjData(self._model) for _ in range(self._threads)]
-    self._scratch = mujoco.MjData(self._model)
-    self._steps = int(round(self.robot.control_timestep / self._model.opt.timestep))
-    self._action_map = np.array(physics.action_map)
-    self._sites = np.array([self._model.site(chain.tip_site_name(k)).id
-                            for k in range(1, self.robot.num_modules + 1)])
-    self._state = np.empty(mujoco.mj_stateSize(self._model, STATE_SPEC))
-    if self._pool is None:
-      self._pool = rollout.Rollout(nthread=self._threads)
+    self._recorder = recorder.PoseRecorder(self.robot, self._threads,
+                                           model=copy.copy(physics.model.ptr))
+    self._state = np.empty(self._recorder.state_size)
 
   def reset(self, episode: base.EpisodeInfo) -> None:
     self._scored = np.array(episode.scored_modules, dtype=int) - 1
 
-  def _features(self, states: np.ndarray, orientation: bool) -> np.ndarray:
-    """(batch, features): scored tip positions over the arm length, then weighted axes."""
-    sites = self._sites[self._scored]
-    features = []
-    for state in states:
-      mujoco.mj_setState(self._model, self._scratch, state, STATE_SPEC)
-      mujoco.mj_kinematics(self._model, self._scratch)
-      feature = [self._scratch.site_xpos[sites].ravel() / self.robot.length]
-      if orientation:
-        axes = self._scratch.site_xmat[sites].reshape(-1, 3, 3)[:, :, 2]
-        feature.append(ORIENTATION_WEIGHT * axes.ravel())
-      features.append(np.concatenate(feature))
-    return np.array(features)
-
   def _simulate(self, actions: np.ndarray, orientation: bool) -> np.ndarray:
-    """Features after holding each action (batch, action_dim) for one control period."""
-    controls = robot_base.action_to_ctrl(self._action_map, actions)[:, None]
-    states, _ = self._pool.rollout([self._model] * len(actions), self._data, self._state[None],
-                                   controls, nstep=self._steps)
-    return self._features(states[:, -1], orientation)
+    """(batch, features) after holding each action (batch, action_dim) for one control period:
+    scored tip positions over the arm length, then weighted orientation vectors."""
+    poses, _ = self._recorder.record(actions[:, None],
+                                     np.broadcast_to(self._state, (len(actions), len(self._state))))
+    scored = poses[:, -1, self._scored]
+    features = [scored[..., :3].reshape(len(actions), -1) / self.robot.length]
+    if orientation:
+      features.append(ORIENTATION_WEIGHT * scored[..., 3:].reshape(len(actions), -1))
+    return np.concatenate(features, axis=1)
 
   def _linearise(self, action: np.ndarray, orientation: bool) -> tuple[np.ndarray, np.ndarray]:
     """Forward-difference Jacobian (features, action_dim) and the features at ``action``."""
@@ -131,7 +111,7 @@ class ReferenceAgent(base.Agent):
     if self._physics is None:
       raise RuntimeError("the reference agent needs bind(physics) before acting")
     physics = self._physics
-    mujoco.mj_getState(physics.model.ptr, physics.data.ptr, self._state, STATE_SPEC)
+    mujoco.mj_getState(physics.model.ptr, physics.data.ptr, self._state, recorder.STATE_SPEC)
     target = np.asarray(observation["target"], dtype=float)
     orientation = target.shape[-1] == 6
     goal = [target[:, :3].ravel() / self.robot.length]

@@ -23,12 +23,15 @@ STATE_SPEC = mujoco.mjtState.mjSTATE_FULLPHYSICS
 class PoseRecorder:
   """Records module poses of ``robot`` under held actions, on ``workers`` threads."""
 
-  def __init__(self, robot: base.SoftArm, workers: int = 1):
+  def __init__(self, robot: base.SoftArm, workers: int = 1,
+               model: mujoco.MjModel | None = None):
+    """``model``: the robot's compiled model to simulate (default ``robot.compile()``), e.g. a
+    copy of an environment's, which a model-based agent plans on."""
     if workers < 1:
       raise ValueError(f"workers must be at least 1, got {workers}")
     self.robot = robot
     self.workers = workers
-    self.model = robot.compile()
+    self.model = model if model is not None else robot.compile()
     self.steps_per_action = int(round(robot.control_timestep / self.model.opt.timestep))
     # The map as stored in the MJCF, exactly as SoftArmPhysics.set_action reads it.
     self._action_map = self.model.numeric(base.ACTION_MAP_NAME).data.reshape(-1, 4).copy()
