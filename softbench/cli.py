@@ -6,6 +6,7 @@ import pathlib
 import sys
 
 from softbench import agents
+from softbench import continual
 from softbench import data
 from softbench import profiles
 from softbench import robots
@@ -77,7 +78,33 @@ def _agents(args: argparse.Namespace) -> None:
     print(f"{name:<10} {'yes' if entry.learned else 'no':<7} {entry.description}")
 
 
+def _run_protocol(args: argparse.Namespace) -> None:
+  if args.protocol != continual.PROTOCOL:
+    raise ValueError(f"unknown protocol {args.protocol!r}; {continual.PROTOCOL} is the one with a "
+                     f"table of its own (exp2s and exp2r are the tasks on tendon-3 and "
+                     f"pneumatic-433: softbench run --task TASK --agent AGENT)")
+  if args.agent != "smpl":
+    raise ValueError(f"--protocol {args.protocol} trains SMPL's columns in sequence; it takes "
+                     f"--agent smpl, got {args.agent!r}")
+  given = [flag for flag, value in (("--task", args.task), ("--robot", args.robot),
+                                    ("--trajectory", args.trajectory)) if value is not None]
+  if given or args.eval != "physics":
+    raise ValueError(f"--protocol {args.protocol} fixes its robots, tasks and loops; drop "
+                     f"{', '.join(given) or '--eval'}")
+  record = continual.execute(profiles.get(args.profile), args.seeds)
+  print(continual.table(record))
+  path = continual.record_path(record, pathlib.Path(args.results))
+  run_module.write_record(record, path)
+  print(f"result record: {path}")
+  if args.json:
+    run_module.write_record(record, pathlib.Path(args.json))
+
+
 def _run(args: argparse.Namespace) -> None:
+  if args.protocol is not None:
+    return _run_protocol(args)
+  if args.task is None:
+    raise ValueError("softbench run needs --task TASK (or --protocol exp1s)")
   settings = run_module.settings(args.task, args.agent, args.robot, args.seeds, args.profile,
                                  args.eval, args.trajectory)
   record = run_module.execute(settings)
@@ -115,7 +142,10 @@ def build_parser() -> argparse.ArgumentParser:
       "run", help="train (or reuse) an agent and score it on a task over seeds",
       description="Collects or reuses the babbling dataset, trains or reuses the agent (cached "
                   "by config), evaluates it closed loop and prints the errors over seeds.")
-  run_parser.add_argument("--task", required=True, help=f"one of {', '.join(suite.TASKS)}")
+  run_parser.add_argument("--task", help=f"one of {', '.join(suite.TASKS)}")
+  run_parser.add_argument("--protocol", help=f"{continual.PROTOCOL}: SMPL learns tendon-1 .. "
+                                             f"tendon-5 in sequence; prints the paper's Exp1S "
+                                             f"table and the forgetting matrix")
   run_parser.add_argument("--agent", required=True, help=f"one of {', '.join(agents.AGENTS)}")
   run_parser.add_argument("--robot", help="default: the task's robot in the paper (tendon-3; "
                                           "pneumatic-433 for reach)")

@@ -117,7 +117,7 @@ def _machine() -> dict:
           "torch": torch.__version__, "device": str(learned.training.default_device())}
 
 
-def _run_seed(run: RunSettings, seed: int, show_progress: bool) -> tuple[dict, tuple[int, ...]]:
+def _run_seed(seed: int, run: RunSettings, show_progress: bool) -> tuple[dict, tuple[int, ...]]:
   """Builds (trains) the agent of ``seed``, runs one episode and scores it."""
   arm = robots.make(run.robot)
   agent = agents.make(run.agent, arm, seed, run.profile, show_progress)
@@ -135,8 +135,9 @@ def _ignore_interrupts() -> None:
   signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
-def _parallel_seeds(run: RunSettings, workers: int) -> list[tuple[dict, tuple[int, ...]]]:
-  """Seeds in ``workers`` processes (one torch and MuJoCo thread each), with one progress bar.
+def _parallel(function, arguments: list[tuple], label: str, workers: int) -> list:
+  """``function(*args)`` for each entry of ``arguments`` in ``workers`` processes (one torch and
+  MuJoCo thread each), with one progress bar; results in order.
 
   On Ctrl-C the workers are terminated; seeds whose checkpoints were written are reused by the
   next run."""
@@ -145,19 +146,34 @@ def _parallel_seeds(run: RunSettings, workers: int) -> list[tuple[dict, tuple[in
   pool = multiprocessing.get_context("spawn").Pool(workers, initializer=_ignore_interrupts)
   try:
     with progress:
-      bar = progress.add_task(f"{run.agent} on {run.task}: seeds ({workers} processes)",
-                              total=run.seeds)
-      pending = [pool.apply_async(_run_seed, (run, seed, False)) for seed in range(run.seeds)]
+      bar = progress.add_task(f"{label} ({workers} processes)", total=len(arguments))
+      pending = [pool.apply_async(function, entry) for entry in arguments]
       while not all(result.ready() for result in pending):
         time.sleep(_POLL_SECONDS)
         progress.update(bar, completed=sum(result.ready() for result in pending))
       outcomes = [result.get() for result in pending]  # Re-raises a worker's error.
-      progress.update(bar, completed=run.seeds)
+      progress.update(bar, completed=len(arguments))
     pool.close()
     return outcomes
   finally:
     pool.terminate()
     pool.join()
+
+
+def over_seeds(function, seeds: int, arguments: tuple, label: str, show_progress: bool,
+                workers: int | None) -> list:
+  """``function(seed, *arguments, show)`` for seeds 0..seeds-1, in parallel on every core."""
+  workers = min(seeds, workers or os.cpu_count() or 1)
+  if workers > 1:
+    return _parallel(function, [(seed, *arguments, False) for seed in range(seeds)],
+                     f"{label}: seeds", workers)
+  return [function(seed, *arguments, show_progress) for seed in range(seeds)]
+
+
+def provenance() -> dict:
+  return {"softbench_version": softbench.__version__, "git_commit": _git_commit(),
+          "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+          "machine": _machine()}
 
 
 def execute(run: RunSettings, show_progress: bool = True, workers: int | None = None) -> dict:
@@ -169,21 +185,15 @@ def execute(run: RunSettings, show_progress: bool = True, workers: int | None = 
   if agents.describe(run.agent).learned:
     data.collect(run.robot, samples=run.profile.samples, seed=learned.DATA_SEED,
                  progress=show_progress)
-  workers = min(run.seeds, workers or os.cpu_count() or 1)
-  if workers > 1:
-    outcomes = _parallel_seeds(run, workers)
-  else:
-    outcomes = [_run_seed(run, seed, show_progress) for seed in range(run.seeds)]
+  outcomes = over_seeds(_run_seed, run.seeds, (run,), f"{run.agent} on {run.task}",
+                         show_progress, workers)
   return {
-      "format": RECORD_FORMAT, "version": RECORD_VERSION,
-      "softbench_version": softbench.__version__, "git_commit": _git_commit(),
+      "format": RECORD_FORMAT, "version": RECORD_VERSION, **provenance(),
       "robot": run.robot, "task": run.task, "agent": run.agent, "profile": run.profile.name,
       "profile_settings": dataclasses.asdict(run.profile), "eval_mode": run.eval_mode,
       "trajectory": run.trajectory, "seeds": run.seeds,
       "scored_modules": list(outcomes[0][1]), "per_seed": [entry for entry, _ in outcomes],
       "wall_time_s": round(time.perf_counter() - started, 3),
-      "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-      "machine": _machine(),
   }
 
 
@@ -215,10 +225,14 @@ def table(record: dict) -> str:
   return "\n".join(lines)
 
 
+def date_stamp(record: dict) -> str:
+  """The record's date as it appears in file names, e.g. 2026-11-24T013000Z."""
+  return record["date"].replace(":", "").replace("+0000", "Z")
+
+
 def record_path(record: dict, results: pathlib.Path) -> pathlib.Path:
-  stamp = record["date"].replace(":", "").replace("+0000", "Z")
   return results / (f"{record['agent']}-{record['robot']}-{record['task']}-{record['profile']}-"
-                    f"{record['eval_mode']}-{stamp}.json")
+                    f"{record['eval_mode']}-{date_stamp(record)}.json")
 
 
 def write_record(record: dict, path: pathlib.Path) -> None:

@@ -166,8 +166,9 @@ class LearnedAgent(base.Agent):
                                        as_tensor(previous_action))
 
 
-def _training_configs(seed: int, profile: profiles.Profile
-                      ) -> tuple[training.ForwardTrainingConfig, training.InverseTrainingConfig]:
+def training_configs(seed: int, profile: profiles.Profile
+                     ) -> tuple[training.ForwardTrainingConfig, training.InverseTrainingConfig]:
+  """The forward and inverse training settings of ``profile``, seeded by ``seed``."""
   common = dict(max_epochs=profile.max_epochs, patience=profile.patience, seed=seed,
                 compile=profile.compile)
   return training.ForwardTrainingConfig(**common), training.InverseTrainingConfig(**common)
@@ -189,11 +190,21 @@ def _inverse_model(views: list[data.View], per_module: bool,
   return make_model(_input_size(view), view.action_size)
 
 
-def _bundle(inverse: InverseModel, forwards: list[smpl_forward.ForwardModel]) -> torch.nn.Module:
+def untrained(views: list[data.View], per_module: bool, make_model: ModelFactory | None
+              ) -> tuple[InverseModel, list[smpl_forward.ForwardModel]]:
+  """Untrained inverse and forward models for ``views``, to load a checkpoint into."""
+  forwards = [smpl_forward.ForwardModel(view.preceding_action_size + view.action_size,
+                                        view.pose_size) for view in views]
+  return _inverse_model(views, per_module, make_model), forwards
+
+
+def bundle(inverse: InverseModel, forwards: list[smpl_forward.ForwardModel]) -> torch.nn.Module:
+  """The module a checkpoint stores: the inverse model and every forward model."""
   return torch.nn.ModuleDict({"inverse": inverse, "forward_models": torch.nn.ModuleList(forwards)})
 
 
-def _progress_bar(label: str, epochs: int, show: bool):
+def progress_bar(label: str, epochs: int, show: bool):
+  """An epoch progress bar (a context manager), or a null context when ``show`` is false."""
   return progress.EpochProgressBar(label, epochs) if show else contextlib.nullcontext(None)
 
 
@@ -202,17 +213,17 @@ def _train(name: str, robot: robot_base.SoftArm, views: list[data.View], seed: i
            ) -> tuple[InverseModel, list[smpl_forward.ForwardModel], list[data.Normalisation]]:
   """Collects or finds the dataset, then trains forward and inverse models (module docstring)."""
   dataset = data.collect(robot, samples=profile.samples, seed=DATA_SEED, progress=show)
-  forward_config, inverse_config = _training_configs(seed, profile)
+  forward_config, inverse_config = training_configs(seed, profile)
   device = training.default_device()
   with training.seeded(seed, torch.device("cpu")):
     inverse = _inverse_model(views, per_module, make_model)
   prepared = []
   for index, view in enumerate(views):
     label = f"{name} {robot.name} seed {seed} {view.name}"
-    with _progress_bar(f"forward {label}", profile.max_epochs, show) as bar:
+    with progress_bar(f"forward {label}", profile.max_epochs, show) as bar:
       prepared.append(protocols.prepare_column(robot, view, dataset, forward_config, device, bar))
     forwards = [column.forward_model for column in prepared]
-    with _progress_bar(f"inverse {label}", profile.max_epochs, show) as bar:
+    with progress_bar(f"inverse {label}", profile.max_epochs, show) as bar:
       if per_module:  # Column by column, all acting together; the earlier ones stay frozen.
         inverse.columns.requires_grad_(False)
         inverse.columns[index].requires_grad_(True)
@@ -241,10 +252,8 @@ def build_agent(name: str, robot: robot_base.SoftArm, seed: int, profile: profil
                          profile.max_epochs, profile.patience, profile.compile)
   path = storage.softbench_home() / CHECKPOINT_FOLDER / f"{config.key}.pt"
   if path.exists():
-    inverse = _inverse_model(views, per_module, make_model)
-    forwards = [smpl_forward.ForwardModel(view.preceding_action_size + view.action_size,
-                                          view.pose_size) for view in views]
-    arrays = checkpoint.load_checkpoint(path, _bundle(inverse, forwards), config)
+    inverse, forwards = untrained(views, per_module, make_model)
+    arrays = checkpoint.load_checkpoint(path, bundle(inverse, forwards), config)
     normalisations = [data.Normalisation.from_arrays(
         {key.removeprefix(f"{view.name}/"): value for key, value in arrays.items()
          if key.startswith(f"{view.name}/")}) for view in views]
@@ -253,7 +262,7 @@ def build_agent(name: str, robot: robot_base.SoftArm, seed: int, profile: profil
                                                make_model, show_progress)
     arrays = {f"{view.name}/{key}": value for view, scale in zip(views, normalisations)
               for key, value in scale.to_arrays().items()}
-    checkpoint.save_checkpoint(path, _bundle(inverse, forwards), config, arrays)
+    checkpoint.save_checkpoint(path, bundle(inverse, forwards), config, arrays)
   inverse.eval()
   controllers = [Controller(view, forward.eval(), scale)
                  for view, forward, scale in zip(views, forwards, normalisations)]

@@ -1,0 +1,253 @@
+"""Exp1S in physics: SMPL learns tendon-1 .. tendon-5 in sequence, one column per configuration,
+and every configuration is scored on its end effector, closed and open loop, in MuJoCo.
+
+Training (cached per seed, like the agents' checkpoints): configuration N's babbling dataset (data
+seed 0, the profile's sample count) in the end-effector view, a frozen forward model, then a new
+column trained in closed loop with the earlier ones frozen (``smpl.protocol.train_next_column``).
+After every stage, every column so far is scored on its own test windows (pose MSE through its
+forward model): the model-level forgetting matrix, measured as training goes.
+
+Acting: configuration N is driven by column N alone, reading the earlier columns through its
+laterals (``ProgressiveColumn``), exactly as if modules N+1.. were detached. Column c reads only
+columns 0..c, so its actions after stage s >= c are those after stage c; the physics forgetting
+matrix (normalised tip error on spiral) is therefore filled from one episode per configuration
+once the model-level matrix shows every earlier column's score unchanged, to the last bit, after
+every later stage. A changed score would be forgetting, and raises.
+"""
+
+import dataclasses
+import hashlib
+import pathlib
+import time
+
+import numpy as np
+import torch
+
+from smpl import checkpoint
+from smpl import forward_model as smpl_forward
+from smpl import progressive
+from smpl import protocol as smpl_protocol
+from smpl import training
+from smpl import windows as smpl_windows
+from softbench import data
+from softbench import evaluation
+from softbench import metrics
+from softbench import profiles
+from softbench import protocols
+from softbench import storage
+from softbench import suite
+from softbench.agents import learned
+from softbench.data import dataset
+
+PROTOCOL = "exp1s"
+TASKS = ("babbling", "circle", "rectangle", "spiral")  # The paper's Exp1S table.
+LOOPS = {"closed": "physics", "open": "open-loop"}  # Table label -> the agent's error source.
+FORGETTING_TASK = "spiral"
+METRICS = ("position_mm", "orientation_deg", "normalised_tip_percent")
+
+
+@dataclasses.dataclass(frozen=True)
+class Exp1sConfig:
+  """Everything the sequentially trained network depends on; its hash names the checkpoint."""
+
+  robots: tuple[str, ...]
+  robot_xml_sha256: tuple[str, ...]
+  samples: int
+  seed: int
+  max_epochs: int
+  patience: int
+  compile: bool
+  training_version: int = learned.TRAINING_VERSION
+
+  @property
+  def key(self) -> str:
+    text = repr(dataclasses.astuple(self)).encode()
+    return f"{PROTOCOL}-seed{self.seed}-{hashlib.sha256(text).hexdigest()[:12]}"
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Exp1sModel:
+  """The trained network, each configuration's controller, and the model-level forgetting
+  matrices (stages x configurations, NaN above the diagonal)."""
+
+  network: progressive.ProgressiveLSTM
+  controllers: list[learned.Controller]
+  arms: list
+  forgetting_pose_mse: np.ndarray
+  forgetting_action_mse: np.ndarray
+
+  def agent(self, configuration: int, seed: int) -> learned.LearnedAgent:
+    """The controller of configuration ``configuration`` (1 = tendon-1): its column alone."""
+    index = configuration - 1
+    column = progressive.ProgressiveColumn(self.network, index)
+    return learned.LearnedAgent(self.arms[index], seed, column, [self.controllers[index]])
+
+
+def _config(seed: int, profile: profiles.Profile, arms: list) -> Exp1sConfig:
+  return Exp1sConfig(tuple(arm.name for arm in arms),
+                     tuple(hashlib.sha256(arm.to_xml().encode()).hexdigest() for arm in arms),
+                     profile.samples, seed, profile.max_epochs, profile.patience, profile.compile)
+
+
+def _train(seed: int, profile: profiles.Profile, show: bool):
+  """Column by column over the configurations; returns network, forwards, normalisations, run."""
+  forward_config, inverse_config = learned.training_configs(seed, profile)
+  device = training.default_device()
+  network = progressive.ProgressiveLSTM()
+  prepared, outcome = [], smpl_protocol.ProgressiveRun(training=[], scores=[])
+  for arm, view in protocols.get(PROTOCOL).column_views():
+    dataset = data.collect(arm, samples=profile.samples, seed=learned.DATA_SEED, progress=show)
+    label = f"{PROTOCOL} seed {seed} {arm.name}"
+    with learned.progress_bar(f"forward {label}", profile.max_epochs, show) as bar:
+      prepared.append(protocols.prepare_column(arm, view, dataset, forward_config, device, bar))
+    with learned.progress_bar(f"inverse {label}", profile.max_epochs, show) as bar:
+      outcome.training.append(smpl_protocol.train_next_column(
+          network, prepared[-1].task, inverse_config, device, bar))
+    outcome.scores.append(smpl_protocol.evaluate_columns(
+        network, list(enumerate(column.task for column in prepared))))
+  network.requires_grad_(False)
+  return (network, [column.forward_model for column in prepared],
+          [column.windows.normalisation for column in prepared], outcome)
+
+
+def _matrices(outcome: smpl_protocol.ProgressiveRun) -> dict[str, np.ndarray]:
+  return {f"forgetting/{metric}": outcome.forgetting_matrix(metric).numpy()
+          for metric in ("pose_mse", "action_mse")}
+
+
+def build(seed: int, profile: profiles.Profile, show_progress: bool = False) -> Exp1sModel:
+  """The Exp1S network of ``seed``: from the checkpoint cache, or trained now and cached."""
+  views_of = protocols.get(PROTOCOL).column_views()
+  arms = [arm for arm, _ in views_of]
+  views = [view for _, view in views_of]
+  config = _config(seed, profile, arms)
+  path = storage.softbench_home() / learned.CHECKPOINT_FOLDER / f"{config.key}.pt"
+  if path.exists():
+    network, forwards = learned.untrained(views, True, None)
+    arrays = checkpoint.load_checkpoint(path, learned.bundle(network, forwards), config)
+    normalisations = [data.Normalisation.from_arrays(
+        {key.removeprefix(f"{arm.name}/"): value for key, value in arrays.items()
+         if key.startswith(f"{arm.name}/")}) for arm in arms]
+    matrices = {key: np.asarray(value) for key, value in arrays.items()
+                if key.startswith("forgetting/")}
+  else:
+    network, forwards, normalisations, outcome = _train(seed, profile, show_progress)
+    matrices = _matrices(outcome)
+    arrays = {f"{arm.name}/{key}": value for arm, scale in zip(arms, normalisations)
+              for key, value in scale.to_arrays().items()}
+    checkpoint.save_checkpoint(path, learned.bundle(network, forwards), config, {**arrays, **matrices})
+  network.eval()
+  controllers = [learned.Controller(view, forward.eval(), scale)
+                 for view, forward, scale in zip(views, forwards, normalisations)]
+  return Exp1sModel(network, controllers, arms, matrices["forgetting/pose_mse"],
+                    matrices["forgetting/action_mse"])
+
+
+def check_no_forgetting(matrix: np.ndarray) -> None:
+  """Raises if any configuration's score changed after a later stage (to the last bit)."""
+  for stage in range(1, len(matrix)):
+    for configuration in range(stage):
+      if matrix[stage, configuration] != matrix[configuration, configuration]:
+        raise RuntimeError(f"configuration {configuration + 1} changed after stage {stage + 1}: "
+                           f"{matrix[configuration, configuration]!r} -> "
+                           f"{matrix[stage, configuration]!r}")
+
+
+def _end_effector_scores(episode: evaluation.Episode, length: float) -> dict:
+  score = episode.score(length)
+  return {name: getattr(score, name)[-1].mean for name in METRICS if getattr(score, name)}
+
+
+def run_seed(seed: int, profile: profiles.Profile, show_progress: bool = False) -> dict:
+  """Trains (or loads) seed ``seed``'s network and scores every configuration, task and loop.
+
+  Returns {"seed", "scores": {loop: {task: [per configuration {metric: value}]}},
+  "forgetting_model_pose_mse", "forgetting_tip_percent"} (matrices as nested lists, NaN -> None).
+  """
+  model = build(seed, profile, show_progress)
+  check_no_forgetting(model.forgetting_pose_mse)
+  check_no_forgetting(model.forgetting_action_mse)
+  scores = {loop: {task: [] for task in TASKS} for loop in LOOPS}
+  for configuration, arm in enumerate(model.arms, start=1):
+    agent = model.agent(configuration, seed)
+    for loop, error_source in LOOPS.items():
+      agent.error_source = error_source
+      for task in TASKS:
+        env = suite.load(arm, task, seed=seed, **task_options(profile))
+        episode = evaluation.run_episode(env, agent, task, show_progress)
+        scores[loop][task].append(_end_effector_scores(episode, arm.length))
+  tip = [entry["normalised_tip_percent"] for entry in scores["closed"][FORGETTING_TASK]]
+  stages = len(model.arms)
+  physics = [[tip[c] if c <= s else None for c in range(stages)] for s in range(stages)]
+  model_level = [[None if np.isnan(value) else float(value) for value in row]
+                 for row in model.forgetting_pose_mse]
+  return {"seed": seed, "scores": scores, "forgetting_model_pose_mse": model_level,
+          "forgetting_tip_percent": physics}
+
+
+def task_options(profile: profiles.Profile) -> dict:
+  return {} if profile.episode_length is None else {"length": profile.episode_length}
+
+
+RECORD_FORMAT = "softbench-exp1s-result"
+RECORD_VERSION = 1
+
+
+def execute(profile: profiles.Profile, seeds: int | None = None, show_progress: bool = True,
+            workers: int | None = None) -> dict:
+  """Every seed (in parallel processes), then the result record with full provenance."""
+  from softbench import run  # run imports the agents; imported here to keep this module light.
+  started = time.perf_counter()
+  seeds = profile.seeds if seeds is None else seeds
+  dataset.check_count("seeds", seeds)
+  for arm, _ in protocols.get(PROTOCOL).column_views():  # Every core collects, before the seeds.
+    data.collect(arm, samples=profile.samples, seed=learned.DATA_SEED, progress=show_progress)
+  per_seed = run.over_seeds(run_seed, seeds, (profile,), f"smpl {PROTOCOL}", show_progress,
+                            workers)
+  return {"format": RECORD_FORMAT, "version": RECORD_VERSION, **run.provenance(),
+          "protocol": PROTOCOL, "agent": "smpl", "robots": list(protocols.get(PROTOCOL).robot_names),
+          "tasks": list(TASKS), "profile": profile.name,
+          "profile_settings": dataclasses.asdict(profile), "seeds": seeds, "per_seed": per_seed,
+          "wall_time_s": round(time.perf_counter() - started, 3)}
+
+
+def _statistic(values: list[float]) -> str:
+  statistic = metrics.Statistic.of(values)
+  return f"{statistic.mean:.2f} ± {statistic.std:.2f}"
+
+
+def table(record: dict) -> str:
+  """The paper's Exp1S layout: per loop, configurations by rows, per task position (mm) and
+  orientation (deg) of the end effector; then normalised tip error; then the forgetting matrix."""
+  per_seed, configurations = record["per_seed"], len(record["robots"])
+  lines = [f"smpl {record['protocol']} ({', '.join(record['robots'])}), profile "
+           f"{record['profile']}, {record['seeds']} seed(s), end effector in physics: "
+           f"mean ± std over seeds"]
+  for metric, label in (("position_mm", "position (mm) / orientation (deg)"),
+                        ("normalised_tip_percent", "normalised tip error (%)")):
+    for loop in LOOPS:
+      lines += ["", f"{loop} loop, {label}",
+                f"{'config':<8}" + "".join(f"{task:>22}" for task in record["tasks"])]
+      for index in range(configurations):
+        cells = []
+        for task in record["tasks"]:
+          value = lambda name: [seed["scores"][loop][task][index][name] for seed in per_seed]
+          cell = _statistic(value(metric))
+          if metric == "position_mm":
+            cell += f" / {metrics.Statistic.of(value('orientation_deg')).mean:.1f}"
+          cells.append(f"{cell:>22}")
+        lines.append(f"{index + 1:<8}" + "".join(cells))
+  lines += ["", f"forgetting matrix: normalised tip error (%) on {FORGETTING_TASK}, closed loop, "
+                f"of each configuration (columns) after each stage (rows)",
+            f"{'stage':<8}" + "".join(f"{c + 1:>16}" for c in range(configurations))]
+  for stage in range(configurations):
+    cells = [_statistic([seed["forgetting_tip_percent"][stage][c] for seed in per_seed])
+             if c <= stage else "" for c in range(configurations)]
+    lines.append(f"{stage + 1:<8}" + "".join(f"{cell:>16}" for cell in cells))
+  lines.append(f"wall time {record['wall_time_s']:.1f} s")
+  return "\n".join(lines)
+
+
+def record_path(record: dict, results: pathlib.Path) -> pathlib.Path:
+  from softbench import run
+  return results / f"smpl-{record['protocol']}-{record['profile']}-{run.date_stamp(record)}.json"

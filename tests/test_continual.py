@@ -1,0 +1,78 @@
+"""Exp1S in physics (``softbench run --protocol exp1s``) on a two-stage sequence, tiny profile."""
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+
+from softbench import cli
+from softbench import continual
+from softbench import protocols
+
+STAGES = ("tendon-1", "tendon-2")
+
+
+@pytest.fixture
+def two_stages(monkeypatch, tmp_path):
+  """tendon-1 then tendon-2 instead of tendon-1 .. 5, in a fresh data home."""
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / "home"))
+  short = dataclasses.replace(protocols.PROTOCOLS[continual.PROTOCOL], robot_names=STAGES)
+  monkeypatch.setitem(protocols.PROTOCOLS, continual.PROTOCOL, short)
+
+
+def test_exp1s_end_to_end(two_stages, tmp_path, capsys):
+  results = tmp_path / "results"
+  argv = ["run", "--protocol", "exp1s", "--agent", "smpl", "--profile", "tiny", "--seeds", "1",
+          "--results", str(results)]
+  assert cli.main(argv) == 0
+  out = capsys.readouterr().out
+  for heading in ("closed loop, position (mm)", "open loop, position (mm)",
+                  "closed loop, normalised tip error (%)", "forgetting matrix"):
+    assert heading in out
+  (path,) = results.glob("smpl-exp1s-tiny-*.json")
+  record = json.loads(path.read_text())
+  assert record["robots"] == list(STAGES) and record["seeds"] == 1
+  (seed,) = record["per_seed"]
+  for loop in continual.LOOPS:
+    for task in continual.TASKS:
+      entries = seed["scores"][loop][task]
+      assert len(entries) == len(STAGES)
+      assert all(np.isfinite(entry[name]) for entry in entries for name in continual.METRICS)
+  matrix = seed["forgetting_tip_percent"]
+  assert matrix[0][1] is None and matrix[1][0] == matrix[0][0]
+  closed_spiral = [entry["normalised_tip_percent"] for entry in seed["scores"]["closed"]["spiral"]]
+  assert matrix[1] == closed_spiral
+  model_level = seed["forgetting_model_pose_mse"]
+  assert model_level[1][0] == model_level[0][0] and model_level[0][1] is None
+  # The second run reuses the cached network and gives the same scores.
+  again = tmp_path / "again.json"
+  assert cli.main([*argv, "--json", str(again)]) == 0
+  assert json.loads(again.read_text())["per_seed"] == record["per_seed"]
+
+
+def test_forgetting_is_detected():
+  matrix = np.array([[0.5, np.nan], [0.5, 0.2]])
+  continual.check_no_forgetting(matrix)
+  matrix[1, 0] = np.nextafter(0.5, 1.0)
+  with pytest.raises(RuntimeError, match="configuration 1 changed after stage 2"):
+    continual.check_no_forgetting(matrix)
+
+
+@pytest.mark.parametrize("extra,message", [
+    (["--agent", "lstm"], "takes --agent smpl"),
+    (["--agent", "smpl", "--task", "spiral"], "drop --task"),
+    (["--agent", "smpl", "--eval", "model"], "drop --eval"),
+])
+def test_exp1s_refuses_bad_input_with_one_line(extra, message, capsys, tmp_path):
+  argv = ["run", "--protocol", "exp1s", *extra, "--results", str(tmp_path)]
+  assert cli.main(argv) == cli.EXIT_USAGE
+  lines = capsys.readouterr().err.strip().splitlines()
+  assert len(lines) == 1 and message in lines[0]
+
+
+def test_unknown_protocol_and_missing_task(capsys):
+  assert cli.main(["run", "--protocol", "exp9", "--agent", "smpl"]) == cli.EXIT_USAGE
+  assert cli.main(["run", "--agent", "smpl"]) == cli.EXIT_USAGE
+  lines = capsys.readouterr().err.strip().splitlines()
+  assert "unknown protocol" in lines[0] and "needs --task" in lines[1]
