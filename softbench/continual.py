@@ -197,14 +197,14 @@ def execute(profile: profiles.Profile, seeds: int | None = None, show_progress: 
             workers: int | None = None) -> dict:
   """Every seed (in parallel processes), then the result record with full provenance."""
   from softbench import run  # run imports the agents; imported here to keep this module light.
-  started = time.perf_counter()
+  started, origin = time.perf_counter(), run.provenance()
   seeds = profile.seeds if seeds is None else seeds
   dataset.check_count("seeds", seeds)
   for arm, _ in protocols.get(PROTOCOL).column_views():  # Every core collects, before the seeds.
     data.collect(arm, samples=profile.samples, seed=learned.DATA_SEED, progress=show_progress)
   per_seed = run.over_seeds(run_seed, seeds, (profile,), f"smpl {PROTOCOL}", show_progress,
                             workers)
-  return {"format": RECORD_FORMAT, "version": RECORD_VERSION, **run.provenance(),
+  return {"format": RECORD_FORMAT, "version": RECORD_VERSION, **origin,
           "protocol": PROTOCOL, "agent": "smpl", "robots": list(protocols.get(PROTOCOL).robot_names),
           "tasks": list(TASKS), "profile": profile.name,
           "profile_settings": dataclasses.asdict(profile), "seeds": seeds, "per_seed": per_seed,

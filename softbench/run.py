@@ -171,6 +171,7 @@ def over_seeds(function, seeds: int, arguments: tuple, label: str, show_progress
 
 
 def provenance() -> dict:
+  """Where and with what a run ran; taken when it starts (the code may change while it runs)."""
   return {"softbench_version": softbench.__version__, "git_commit": _git_commit(),
           "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
           "machine": _machine()}
@@ -181,14 +182,14 @@ def execute(run: RunSettings, show_progress: bool = True, workers: int | None = 
 
   The babbling dataset is collected first (on every core), so that the seeds share it.
   """
-  started = time.perf_counter()
+  started, origin = time.perf_counter(), provenance()
   if agents.describe(run.agent).learned:
     data.collect(run.robot, samples=run.profile.samples, seed=learned.DATA_SEED,
                  progress=show_progress)
   outcomes = over_seeds(_run_seed, run.seeds, (run,), f"{run.agent} on {run.task}",
                          show_progress, workers)
   return {
-      "format": RECORD_FORMAT, "version": RECORD_VERSION, **provenance(),
+      "format": RECORD_FORMAT, "version": RECORD_VERSION, **origin,
       "robot": run.robot, "task": run.task, "agent": run.agent, "profile": run.profile.name,
       "profile_settings": dataclasses.asdict(run.profile), "eval_mode": run.eval_mode,
       "trajectory": run.trajectory, "seeds": run.seeds,
