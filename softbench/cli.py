@@ -8,6 +8,7 @@ import sys
 from softbench import agents
 from softbench import continual
 from softbench import data
+from softbench import leaderboard
 from softbench import profiles
 from softbench import robots
 from softbench import run as run_module
@@ -116,6 +117,15 @@ def _run(args: argparse.Namespace) -> None:
     run_module.write_record(record, pathlib.Path(args.json))
 
 
+def _leaderboard(args: argparse.Namespace) -> None:
+  results = pathlib.Path(args.results)
+  board = leaderboard.build(results)
+  print(leaderboard.text.report(board, results))
+  if args.write:
+    for path in leaderboard.write(board, results, pathlib.Path(args.out)):
+      print(f"wrote {path}")
+
+
 def build_parser() -> argparse.ArgumentParser:
   parser = argparse.ArgumentParser(prog="softbench", description=__doc__.split(".")[0] + ".")
   commands = parser.add_subparsers(dest="command", required=True)
@@ -160,6 +170,19 @@ def build_parser() -> argparse.ArgumentParser:
                           help="folder of the result records (default leaderboard/results)")
   run_parser.add_argument("--json", help="also write the result record to this file")
   run_parser.set_defaults(run=_run)
+  board_parser = commands.add_parser(
+      "leaderboard", help="rank the result records per robot and task",
+      description="Checks every result record (schema and integrity hash) and prints, per robot "
+                  "and task, the newest record of each agent, profile and eval mode, ranked by "
+                  "position error: mean ± std over seeds [95% bootstrap CI].")
+  board_parser.add_argument("--results", default=str(leaderboard.DEFAULT_RESULTS),
+                            help=f"folder of the result records (default "
+                                 f"{leaderboard.DEFAULT_RESULTS})")
+  board_parser.add_argument("--write", action="store_true",
+                            help="also regenerate README.md and index.html in --out")
+  board_parser.add_argument("--out", default=str(leaderboard.DEFAULT_OUT),
+                            help=f"folder of the pages (default {leaderboard.DEFAULT_OUT})")
+  board_parser.set_defaults(run=_leaderboard)
   models = commands.add_parser("models", help="exported MJCF models")
   models_commands = models.add_subparsers(dest="models_command", required=True)
   export_parser = models_commands.add_parser("export", help="write models/<name>/ for every robot")

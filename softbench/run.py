@@ -8,7 +8,6 @@ deviation over seeds. Every run writes a result record with full provenance.
 
 import dataclasses
 import datetime
-import json
 import multiprocessing
 import os
 import pathlib
@@ -28,10 +27,10 @@ from softbench import evaluation
 from softbench import metrics
 from softbench import profiles
 from softbench import robots
-from softbench import storage
 from softbench import suite
 from softbench.agents import learned
 from softbench.data import dataset
+from softbench.leaderboard import records
 
 PAPER_ROBOT = {"babbling": "tendon-3", "circle": "tendon-3", "rectangle": "tendon-3",
                "spiral": "tendon-3", "custom": "tendon-3", "reach": "pneumatic-433"}
@@ -40,8 +39,8 @@ arm), the default of ``--robot``."""
 METRICS = (("position_mm", "position (mm)"), ("orientation_deg", "orientation (deg)"),
            ("normalised_tip_percent", "tip error (%)"))
 _POLL_SECONDS = 0.2  # (s) How often the parent looks at its worker processes.
-RECORD_FORMAT = "softbench-result"
-RECORD_VERSION = 1
+RECORD_FORMAT = records.FORMAT
+RECORD_VERSION = records.VERSION
 
 
 @dataclasses.dataclass(frozen=True)
@@ -236,5 +235,7 @@ def record_path(record: dict, results: pathlib.Path) -> pathlib.Path:
                     f"{record['eval_mode']}-{date_stamp(record)}.json")
 
 
-def write_record(record: dict, path: pathlib.Path) -> None:
-  storage.write_atomically(path, json.dumps(record, indent=2, sort_keys=True) + "\n")
+def write_record(record: dict, path: pathlib.Path) -> dict:
+  """Checks ``record`` against the schema, seals it with its integrity hash and writes it
+  atomically (``leaderboard.records.write``); returns the sealed record."""
+  return records.write(record, path)

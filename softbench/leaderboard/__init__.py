@@ -1,0 +1,45 @@
+"""The leaderboard: result records ranked per robot and task, printed and written as pages.
+
+``records`` (schema, integrity hash, checked reading and writing), ``ranking`` (newest record per
+agent, profile and eval mode; mean, std and bootstrap interval over seeds), ``text`` (the
+printout), ``markdown_page`` and ``html_page`` (``README.md`` and ``index.html``).
+"""
+
+import pathlib
+
+from softbench import storage
+from softbench.leaderboard import html_page
+from softbench.leaderboard import markdown_page
+from softbench.leaderboard import ranking
+from softbench.leaderboard import records
+from softbench.leaderboard import text
+
+DEFAULT_RESULTS = records.DEFAULT_FOLDER
+DEFAULT_OUT = pathlib.Path("leaderboard")
+
+
+def build(results: pathlib.Path = DEFAULT_RESULTS) -> ranking.Leaderboard:
+  """The leaderboard of every record in ``results`` (empty if the folder does not exist).
+
+  Raises:
+    records.RecordError: a record is malformed or was edited (one line naming the file).
+  """
+  return ranking.rank(records.read_folder(results))
+
+
+def write(board: ranking.Leaderboard, results: pathlib.Path = DEFAULT_RESULTS,
+          out: pathlib.Path = DEFAULT_OUT) -> list[pathlib.Path]:
+  """Writes ``README.md`` and ``index.html`` of ``board`` into ``out`` (atomically); returns
+  their paths. Links to records and videos are relative to ``out``."""
+  out = pathlib.Path(out)
+  if out.exists() and not out.is_dir():
+    raise ValueError(f"{out}: not a folder; --out takes the folder of the pages")
+  pages = {"README.md": markdown_page.render(board, results, out),
+           "index.html": html_page.render(board, results, out)}
+  for name, content in pages.items():
+    storage.write_atomically(out / name, content)
+  return [out / name for name in pages]
+
+
+__all__ = ["DEFAULT_OUT", "DEFAULT_RESULTS", "build", "ranking", "records", "text",
+           "write"]

@@ -1,0 +1,182 @@
+"""The leaderboard as one self-contained static page (``leaderboard/index.html``).
+
+Inline CSS and JavaScript, no external resource: per robot and task a table whose columns sort
+on a click, and a bar chart (inline SVG) per metric of the mean error with its bootstrap
+interval as a whisker; links to each record and its video. The page carries no time of its
+own, so the same records give the same bytes.
+"""
+
+import html
+import pathlib
+
+from softbench.leaderboard import links
+from softbench.leaderboard import ranking
+
+_CHART_WIDTH = 640  # (px) of an SVG bar chart.
+_CHART_LABEL_WIDTH = 210  # (px) left of the bars, for the row's agent / profile / eval.
+_CHART_VALUE_WIDTH = 70  # (px) right of the bars, for the mean.
+_CHART_ROW_HEIGHT = 22  # (px) per bar.
+_CHART_BAR_HEIGHT = 14  # (px)
+_CHART_PAD = 6  # (px) above the first and below the last bar.
+
+_STYLE = """
+body { font-family: system-ui, sans-serif; margin: 2rem auto; max-width: 72rem; padding: 0 1rem;
+       color: #1b1f24; line-height: 1.45; }
+h1 { font-size: 1.6rem; } h2 { font-size: 1.25rem; margin-top: 2.5rem; }
+table { border-collapse: collapse; margin: 0.8rem 0; font-size: 0.9rem; }
+th, td { border-bottom: 1px solid #d0d7de; padding: 0.3rem 0.6rem; text-align: left; }
+th { background: #f3f5f7; cursor: pointer; user-select: none; white-space: nowrap; }
+th[aria-sort="ascending"]::after { content: " \\25B2"; }
+th[aria-sort="descending"]::after { content: " \\25BC"; }
+td.number { text-align: right; font-variant-numeric: tabular-nums; }
+td.figure { font-variant-numeric: tabular-nums; white-space: nowrap; }
+.charts { display: flex; flex-wrap: wrap; gap: 1rem; }
+figure { margin: 0; } figcaption { font-size: 0.85rem; color: #57606a; }
+svg text { font-size: 11px; fill: #1b1f24; }
+svg .bar { fill: #4c78a8; } svg .whisker { stroke: #1b1f24; stroke-width: 1.2; }
+.note { color: #57606a; font-size: 0.9rem; }
+"""
+
+_SCRIPT = """
+function sortTable(table, header, column) {
+  var ascending = header.getAttribute("aria-sort") !== "ascending";
+  table.querySelectorAll("th").forEach(function (th) { th.removeAttribute("aria-sort"); });
+  header.setAttribute("aria-sort", ascending ? "ascending" : "descending");
+  var numeric = header.dataset.type === "number";
+  var key = function (row) {
+    var cell = row.cells[column];
+    var value = cell.dataset.value !== undefined ? cell.dataset.value : cell.textContent;
+    if (!numeric) return value;
+    return value === "" ? Infinity : parseFloat(value);
+  };
+  var body = table.tBodies[0];
+  var rows = Array.prototype.slice.call(body.rows);
+  rows.sort(function (a, b) {
+    var x = key(a), y = key(b);
+    var order = x < y ? -1 : (x > y ? 1 : 0);
+    return ascending ? order : -order;
+  });
+  rows.forEach(function (row) { body.appendChild(row); });
+}
+document.querySelectorAll("table.sortable").forEach(function (table) {
+  table.querySelectorAll("th").forEach(function (header, column) {
+    header.tabIndex = 0;
+    header.addEventListener("click", function () { sortTable(table, header, column); });
+    header.addEventListener("keydown", function (event) {
+      if (event.key === "Enter" || event.key === " ") {
+        event.preventDefault();
+        sortTable(table, header, column);
+      }
+    });
+  });
+});
+"""
+
+
+def _e(text: object) -> str:
+  return html.escape(str(text), quote=True)
+
+
+def _px(value: float) -> str:
+  return f"{value:.1f}"
+
+
+def _chart(group: ranking.Group, metric: str) -> str:
+  """Horizontal bars of the mean of ``metric`` per row, whiskers over the bootstrap interval."""
+  rows = [entry for entry in group.entries if metric in entry.estimates]
+  bars_width = _CHART_WIDTH - _CHART_LABEL_WIDTH - _CHART_VALUE_WIDTH
+  height = 2 * _CHART_PAD + _CHART_ROW_HEIGHT * len(rows)
+  highest = max(max([estimate.mean, *(estimate.interval or ())]) for estimate in
+                (entry.estimates[metric] for entry in rows))
+  scale = bars_width / highest if highest > 0 else 0.0
+  label = ranking.METRIC_LABELS[metric]
+  parts = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{_CHART_WIDTH}" height="{height}" '
+           f'viewBox="0 0 {_CHART_WIDTH} {height}" role="img" aria-label="{_e(label)}">']
+  for index, entry in enumerate(rows):
+    estimate = entry.estimates[metric]
+    top = _CHART_PAD + index * _CHART_ROW_HEIGHT
+    middle = top + _CHART_ROW_HEIGHT / 2
+    bar_top = middle - _CHART_BAR_HEIGHT / 2
+    parts.append(f"<g><title>{_e(entry.label)}: {_e(ranking.cell(estimate))}</title>")
+    parts.append(f'<text x="{_CHART_LABEL_WIDTH - 6}" y="{_px(middle + 4)}" '
+                 f'text-anchor="end">{_e(entry.label)}</text>')
+    parts.append(f'<rect class="bar" x="{_CHART_LABEL_WIDTH}" y="{_px(bar_top)}" '
+                 f'width="{_px(estimate.mean * scale)}" height="{_CHART_BAR_HEIGHT}"/>')
+    if estimate.interval is not None:
+      low, high = (_CHART_LABEL_WIDTH + value * scale for value in estimate.interval)
+      parts.append(f'<path class="whisker" d="M{_px(low)} {_px(middle)}H{_px(high)}'
+                   f'M{_px(low)} {_px(middle - 4)}V{_px(middle + 4)}'
+                   f'M{_px(high)} {_px(middle - 4)}V{_px(middle + 4)}"/>')
+    parts.append(f'<text x="{_CHART_WIDTH - _CHART_VALUE_WIDTH + 6}" y="{_px(middle + 4)}">'
+                 f'{_e(ranking.number(estimate.mean))}</text></g>')
+  parts.append("</svg>")
+  caption = (f"{label}, mean over seeds (lower is better); whiskers: "
+             f"{ranking.CONFIDENCE:.0%} bootstrap CI")
+  return f"<figure>{''.join(parts)}<figcaption>{_e(caption)}</figcaption></figure>"
+
+
+def _table(group: ranking.Group, out: pathlib.Path) -> str:
+  columns = ([("#", "number"), ("agent", "text"), ("profile", "text"), ("eval", "text"),
+              ("seeds", "number")] +
+             [(ranking.METRIC_LABELS[name], "number") for name in group.metrics] +
+             [("video", "text"), ("record", "text")])
+  head = "".join(f'<th scope="col" data-type="{kind}">{_e(name)}</th>' for name, kind in columns)
+  body = []
+  for place, entry in enumerate(group.entries, start=1):
+    cells = [f'<td class="number">{place}</td>',
+             *(f"<td>{_e(value)}</td>" for value in entry.setting),
+             f'<td class="number">{entry.record["seeds"]}</td>']
+    for name in group.metrics:
+      estimate = entry.estimates.get(name)
+      value = "" if estimate is None else repr(estimate.mean)
+      cells.append(f'<td class="figure" data-value="{value}">{_e(ranking.cell(estimate))}</td>')
+    video = links.video(entry, out)
+    cells.append(f'<td><a href="{_e(video)}">video</a></td>' if video else "<td>-</td>")
+    cells.append(f'<td><a href="{_e(links.record(entry, out))}">{_e(entry.path.name)}</a></td>')
+    body.append(f"<tr>{''.join(cells)}</tr>")
+  return (f'<table class="sortable"><thead><tr>{head}</tr></thead>'
+          f'<tbody>{"".join(body)}</tbody></table>')
+
+
+def _group(group: ranking.Group, out: pathlib.Path) -> str:
+  parts = [f'<section id="{_e(group.anchor)}"><h2>{_e(group.title)}</h2>', _table(group, out),
+           '<div class="charts">' + "".join(_chart(group, name) for name in group.metrics) +
+           "</div>"]
+  if group.superseded:
+    items = "".join(f'<li><a href="{_e(links.record(entry, out))}">{_e(entry.path.name)}</a> '
+                    f"({_e(entry.label)}, {_e(entry.record['date'])})</li>"
+                    for entry in group.superseded)
+    parts.append('<p class="note">Superseded by a newer record of the same agent, profile and '
+                 f"eval mode:</p><ul class=\"note\">{items}</ul>")
+  parts.append("</section>")
+  return "\n".join(parts)
+
+
+def render(board: ranking.Leaderboard, results: pathlib.Path, out: pathlib.Path) -> str:
+  """The page, with links relative to the folder ``out`` it is written to."""
+  results_link = links.relative(pathlib.Path(results), out)
+  intro = [f'<p class="note">Generated by <code>softbench leaderboard --write</code> from the '
+           f'result records in <a href="{_e(results_link)}">{_e(results_link)}</a>.</p>']
+  if board.record_count:
+    intro.append(
+        f"<p>{board.record_count} record(s), the newest from {_e(board.latest_date)}. Each row "
+        "is the newest record of one agent, profile and eval mode, ranked by position error "
+        "(lower is better; click a column to sort). Figures: mean ± standard deviation over "
+        "seeds of the episode's error averaged over the scored modules, "
+        f"[{ranking.CONFIDENCE:.0%} percentile bootstrap confidence interval of the mean, "
+        f"{ranking.BOOTSTRAP_RESAMPLES:,} resamples] with {ranking.MIN_SEEDS_FOR_INTERVAL} or "
+        "more seeds. How to submit an agent: the <em>Leaderboard</em> section of softbench's "
+        "README.</p>")
+    intro.append("<nav><ul>" + "".join(f'<li><a href="#{_e(group.anchor)}">{_e(group.title)}'
+                                        f"</a></li>" for group in board.groups) + "</ul></nav>")
+  else:
+    intro.append("<p>No result records yet. Make one with <code>softbench run</code> (for "
+                 "example <code>softbench run --task spiral --agent smpl</code>), then run "
+                 "<code>softbench leaderboard --write</code>.</p>")
+  return "\n".join([
+      "<!DOCTYPE html>", '<html lang="en">', "<head>", '<meta charset="utf-8">',
+      '<meta name="viewport" content="width=device-width, initial-scale=1">',
+      "<title>softbench leaderboard</title>", f"<style>{_STYLE}</style>", "</head>", "<body>",
+      "<h1>softbench leaderboard</h1>", *intro,
+      *(_group(group, out) for group in board.groups),
+      f"<script>{_SCRIPT}</script>", "</body>", "</html>", ""])

@@ -1,0 +1,180 @@
+"""The ranking: records grouped by robot and task, ordered by position error.
+
+Within a group (robot, task, and for ``custom`` the trajectory; records with extra sections, such
+as a fault, form groups of their own), each (agent, profile, eval mode) is represented by its
+newest record (by date, then file name); older ones are kept as superseded. Rows are ordered by
+the mean over seeds of the episode's module-averaged position error. Every metric gets the mean
+and standard deviation (ddof 0, as ``softbench run`` prints) over seeds of the per-seed means and
+a 95 % percentile bootstrap confidence interval of the mean (``scipy.stats.bootstrap``, the method
+rliable uses by default), with a fixed random generator so that the same records give the same
+numbers; with fewer than 2 seeds there is no interval.
+"""
+
+import dataclasses
+import datetime
+import math
+import pathlib
+import re
+
+import numpy as np
+
+from softbench import suite
+from softbench.leaderboard import records
+
+CONFIDENCE = 0.95
+BOOTSTRAP_RESAMPLES = 10_000
+BOOTSTRAP_SEED = 0  # Fixed: regenerating the leaderboard gives the same intervals.
+MIN_SEEDS_FOR_INTERVAL = 2
+RANKED_BY = "position_mm"
+METRIC_LABELS = {"position_mm": "position (mm)", "orientation_deg": "orientation (deg)",
+                 "normalised_tip_percent": "tip error (%)"}
+
+
+@dataclasses.dataclass(frozen=True)
+class Estimate:
+  """A metric over seeds: mean, standard deviation and the 95 % bootstrap interval of the mean
+  (``None`` with fewer than ``MIN_SEEDS_FOR_INTERVAL`` seeds)."""
+
+  mean: float
+  std: float
+  interval: tuple[float, float] | None
+
+  @classmethod
+  def of(cls, values: list[float]) -> "Estimate":
+    values = np.asarray(values, dtype=float)
+    return cls(float(np.mean(values)), float(np.std(values)), _bootstrap_interval(values))
+
+
+def _bootstrap_interval(values: np.ndarray) -> tuple[float, float] | None:
+  if values.size < MIN_SEEDS_FOR_INTERVAL:
+    return None
+  if np.ptp(values) == 0:  # Every resample has the same mean; scipy would warn and give NaN.
+    return float(values[0]), float(values[0])
+  from scipy import stats  # Here: importing it takes 0.5 s, which softbench run need not pay.
+  result = stats.bootstrap((values,), np.mean, n_resamples=BOOTSTRAP_RESAMPLES,
+                           confidence_level=CONFIDENCE, method="percentile", vectorized=True,
+                           rng=np.random.default_rng(BOOTSTRAP_SEED))
+  return float(result.confidence_interval.low), float(result.confidence_interval.high)
+
+
+@dataclasses.dataclass(frozen=True)
+class Entry:
+  """One record as the leaderboard shows it."""
+
+  path: pathlib.Path
+  record: dict
+  estimates: dict[str, Estimate]  # By metric name, for the metrics the record holds.
+
+  @classmethod
+  def of(cls, path: pathlib.Path, record: dict) -> "Entry":
+    measured = [name for name in records.METRICS if name in record["per_seed"][0]]
+    return cls(pathlib.Path(path), record, {
+        name: Estimate.of([seed[name]["mean"] for seed in record["per_seed"]])
+        for name in measured})
+
+  @property
+  def setting(self) -> tuple[str, str, str]:
+    """What one row stands for: (agent, profile, eval mode)."""
+    return self.record["agent"], self.record["profile"], self.record["eval_mode"]
+
+  @property
+  def label(self) -> str:
+    return " / ".join(self.setting)
+
+
+@dataclasses.dataclass(frozen=True)
+class Group:
+  """The ranked rows of one robot and task, and the records they superseded."""
+
+  robot: str
+  task: str
+  variant: str  # "" for the plain task; else the trajectory and/or the extra sections.
+  entries: tuple[Entry, ...]  # Ranked, best first.
+  superseded: tuple[Entry, ...]  # Older records of a shown setting, newest first.
+
+  @property
+  def title(self) -> str:
+    return f"{self.robot} · {self.task}" + (f" ({self.variant})" if self.variant else "")
+
+  @property
+  def anchor(self) -> str:
+    """An id for links: letters, digits and dashes."""
+    return re.sub(r"[^a-z0-9]+", "-", self.title.lower()).strip("-")
+
+  @property
+  def metrics(self) -> tuple[str, ...]:
+    """The metrics any row holds, in ``records.METRICS`` order."""
+    return tuple(name for name in records.METRICS
+                 if any(name in entry.estimates for entry in self.entries))
+
+
+@dataclasses.dataclass(frozen=True)
+class Leaderboard:
+  groups: tuple[Group, ...]
+  record_count: int
+  latest_date: str | None  # The newest record's date: the pages carry no time of their own.
+
+
+def _group_key(record: dict) -> tuple[str, str, str]:
+  variant = [f"trajectory {record['trajectory']}"] if record["trajectory"] is not None else []
+  variant += [f"with {name}" for name in records.sections(record)]
+  return record["robot"], record["task"], ", ".join(variant)
+
+
+def _robot_order(robot: str) -> tuple:
+  family, _, size = robot.partition("-")
+  return family, int(size) if size.isdigit() else 0, robot
+
+
+def _moment(record: dict) -> datetime.datetime:
+  return datetime.datetime.fromisoformat(record["date"])  # Checked, with a time zone.
+
+
+def _newest_first(entry: Entry) -> tuple:
+  return _moment(entry.record), entry.path.name
+
+
+def rank(loaded: list[tuple[pathlib.Path, dict]]) -> Leaderboard:
+  """The leaderboard of checked records (``records.read_folder``)."""
+  by_group: dict[tuple[str, str, str], list[Entry]] = {}
+  for path, record in loaded:
+    by_group.setdefault(_group_key(record), []).append(Entry.of(path, record))
+  groups = []
+  for key in sorted(by_group, key=lambda k: (_robot_order(k[0]), suite.TASKS.index(k[1]), k[2])):
+    newest: dict[tuple[str, str, str], Entry] = {}
+    superseded = []
+    for entry in sorted(by_group[key], key=_newest_first, reverse=True):
+      if entry.setting in newest:
+        superseded.append(entry)
+      else:
+        newest[entry.setting] = entry
+    ranked = sorted(newest.values(),
+                    key=lambda entry: (entry.estimates[RANKED_BY].mean, entry.setting))
+    groups.append(Group(*key, tuple(ranked), tuple(superseded)))
+  latest = max((record for _, record in loaded), key=_moment, default=None)
+  return Leaderboard(tuple(groups), len(loaded), None if latest is None else latest["date"])
+
+
+def _decimals(value: float) -> int:
+  """2 decimals from 1 up; below 1, enough for 3 significant digits."""
+  if value == 0 or abs(value) >= 1:
+    return 2
+  return max(2, 2 - math.floor(math.log10(abs(value))))
+
+
+def number(value: float, decimals: int | None = None) -> str:
+  """A figure as the leaderboard prints it, with ``decimals`` (default: ``_decimals(value)``)."""
+  return f"{value:.{_decimals(value) if decimals is None else decimals}f}"
+
+
+def cell(estimate: Estimate | None) -> str:
+  """``mean ± std [low, high]``, all with the decimals of the mean; ``-`` for a metric the
+  record does not hold."""
+  if estimate is None:
+    return "-"
+  decimals = _decimals(estimate.mean)
+  text = f"{number(estimate.mean, decimals)} ± {number(estimate.std, decimals)}"
+  if estimate.interval is not None:
+    low, high = estimate.interval
+    text += f" [{number(low, decimals)}, {number(high, decimals)}]"
+  return text

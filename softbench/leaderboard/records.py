@@ -1,0 +1,273 @@
+"""Result records: their JSON Schema, their integrity hash, and checked writing and reading.
+
+A record is one ``softbench run`` (format ``softbench-result``, version 2): provenance, settings
+and per-seed errors. ``write`` seals a record with ``sha256``, the hash of the canonical JSON of
+everything else in it, and ``read`` refuses a file that is not valid JSON, does not match the
+schema (``schema()``, JSON Schema draft 2020-12), holds a non-finite number, no longer matches its
+hash (a hand-edited number), or contradicts itself (seed count, module counts, the mean over
+modules). Every refusal is one line that names the file.
+
+Fields other than the known ones are allowed only as sections (JSON objects), which other
+commands add to their records (a fault, an adaptive schedule); the hash covers them too.
+Version 1 records (before the hash) are refused: they cannot be checked.
+"""
+
+import copy
+import datetime
+import hashlib
+import json
+import math
+import pathlib
+
+import jsonschema
+from jsonschema import exceptions as schema_exceptions
+
+from softbench import profiles
+from softbench import robots
+from softbench import storage
+from softbench import suite
+from softbench.agents import learned
+
+DEFAULT_FOLDER = pathlib.Path("leaderboard/results")  # Where softbench run writes records.
+FORMAT = "softbench-result"
+VERSION = 2
+INTEGRITY_FIELD = "sha256"
+METRICS = ("position_mm", "orientation_deg", "normalised_tip_percent")
+"""Errors a record may hold per seed; position and normalised tip error always, orientation
+except for position-only tasks (reach)."""
+_OPTIONAL_FIELDS = ("video",)
+_MEAN_TOLERANCE = 1e-9  # Relative: a seed's mean against the mean of its per-module values.
+_MAX_MESSAGE_CHARS = 160  # Of a schema error's message, so that a refusal stays one line.
+
+
+class RecordError(ValueError):
+  """A result record that cannot be used; the message names the file."""
+
+
+def schema() -> dict:
+  """The JSON Schema (draft 2020-12) of a result record, enums from the current registries."""
+  non_negative = {"type": "number", "minimum": 0}
+  per_module = {"type": "array", "items": non_negative, "minItems": 1}
+  metric = {"type": "object", "additionalProperties": False,
+            "required": ["per_module", "per_module_std_over_steps", "mean"],
+            "properties": {"per_module": per_module, "per_module_std_over_steps": per_module,
+                           "mean": non_negative}}
+  section = {"type": "object"}
+  seed = {
+      "type": "object",
+      "required": ["seed", "steps", "mean_reward", "position_mm", "normalised_tip_percent"],
+      "properties": {"seed": {"type": "integer", "minimum": 0},
+                     "steps": {"type": "integer", "minimum": 1},
+                     "mean_reward": {"type": "number", "minimum": 0, "maximum": 1},
+                     **{name: metric for name in METRICS}},
+      "additionalProperties": section,
+  }
+  properties = {
+      "format": {"const": FORMAT},
+      "version": {"const": VERSION},
+      "softbench_version": {"type": "string", "minLength": 1},
+      "git_commit": {"type": ["string", "null"]},
+      "robot": {"type": "string", "pattern": r"^(tendon-[0-9]+|pneumatic-433)$"},
+      "task": {"enum": list(suite.TASKS)},
+      "agent": {"type": "string", "pattern": r"^[a-z0-9][a-z0-9_.-]*$", "maxLength": 64},
+      "profile": {"enum": list(profiles.PROFILES)},
+      "profile_settings": {"type": "object", "required": ["name"],
+                           "properties": {"name": {"type": "string"}}},
+      "eval_mode": {"enum": list(learned.ERROR_SOURCES)},
+      "trajectory": {"type": ["string", "null"]},
+      "seeds": {"type": "integer", "minimum": 1},
+      "scored_modules": {"type": "array", "items": {"type": "integer", "minimum": 1},
+                         "minItems": 1, "uniqueItems": True},
+      "per_seed": {"type": "array", "items": seed, "minItems": 1},
+      "wall_time_s": non_negative,
+      "date": {"type": "string", "format": "date-time"},
+      "machine": {"type": "object"},
+      "video": {"type": "string", "minLength": 1},
+      INTEGRITY_FIELD: {"type": "string", "pattern": "^[0-9a-f]{64}$"},
+  }
+  return {
+      "$schema": "https://json-schema.org/draft/2020-12/schema",
+      "title": "softbench result record",
+      "type": "object",
+      "required": [name for name in properties if name not in _OPTIONAL_FIELDS],
+      "properties": properties,
+      "additionalProperties": section,
+  }
+
+
+def sections(record: dict) -> tuple[str, ...]:
+  """The names of a record's extra sections (fields the schema does not name), sorted."""
+  return tuple(sorted(set(record) - set(schema()["properties"])))
+
+
+def content_sha256(record: dict) -> str:
+  """The sha256 of the canonical JSON (sorted keys, no spaces) of the record without its hash."""
+  content = {name: value for name, value in record.items() if name != INTEGRITY_FIELD}
+  canonical = json.dumps(content, sort_keys=True, separators=(",", ":"), ensure_ascii=False,
+                         allow_nan=False)
+  return hashlib.sha256(canonical.encode("utf-8")).hexdigest()
+
+
+def seal(record: dict) -> dict:
+  """A deep copy of ``record`` with its integrity hash, checked.
+
+  Raises:
+    RecordError: the record does not match the schema or contradicts itself (one line).
+  """
+  sealed = copy.deepcopy({name: value for name, value in record.items()
+                          if name != INTEGRITY_FIELD})
+  _check_finite(sealed, "record")
+  sealed[INTEGRITY_FIELD] = content_sha256(sealed)
+  validate(sealed, "record")
+  return sealed
+
+
+def dumps(record: dict) -> str:
+  """The file content of a record: indented JSON with sorted keys."""
+  return json.dumps(record, indent=2, sort_keys=True, allow_nan=False) + "\n"
+
+
+def write(record: dict, path: pathlib.Path) -> dict:
+  """Seals ``record`` and writes it to ``path`` atomically; returns the sealed record."""
+  sealed = seal(record)
+  storage.write_atomically(path, dumps(sealed))
+  return sealed
+
+
+def read(path: pathlib.Path) -> dict:
+  """The checked record in ``path``.
+
+  Raises:
+    RecordError: the file is not valid JSON or not a valid, untouched record (one line).
+    FileNotFoundError: no such file.
+  """
+  path = pathlib.Path(path)
+  try:
+    record = json.loads(path.read_text(encoding="utf-8"))
+  except FileNotFoundError:
+    raise
+  except OSError as error:
+    raise RecordError(f"{path}: cannot be read ({error.strerror})") from None
+  except UnicodeDecodeError as error:
+    raise RecordError(f"{path}: not UTF-8 text ({error.reason})") from None
+  except json.JSONDecodeError as error:
+    raise RecordError(f"{path}: not valid JSON ({error.msg} at line {error.lineno}, "
+                      f"column {error.colno})") from None
+  validate(record, str(path))
+  return record
+
+
+def read_folder(folder: pathlib.Path) -> list[tuple[pathlib.Path, dict]]:
+  """Every record (``*.json``) in ``folder``, checked, sorted by file name; none if the folder
+  does not exist.
+
+  Raises:
+    RecordError: a file is not a valid, untouched record, or ``folder`` is a file (one line).
+  """
+  folder = pathlib.Path(folder)
+  if folder.exists() and not folder.is_dir():
+    raise RecordError(f"{folder}: not a folder of result records")
+  return [(path, read(path)) for path in sorted(folder.glob("*.json"))]
+
+
+def validate(record: object, source: str) -> None:
+  """Checks a record: format and version, finite numbers, schema, hash, consistency.
+
+  Raises:
+    RecordError: the first problem found, one line starting with ``source``.
+  """
+  if not isinstance(record, dict):
+    raise RecordError(f"{source}: not a result record (a JSON object is expected)")
+  if record.get("format") != FORMAT:
+    raise RecordError(f"{source}: not a result record (format {record.get('format')!r}, "
+                      f"expected {FORMAT!r})")
+  version = record.get("version")
+  if version != VERSION:
+    why = ("it has no integrity hash, so it cannot be checked; run it again"
+           if isinstance(version, int) and version < VERSION else
+           f"this softbench reads version {VERSION}")
+    raise RecordError(f"{source}: record version {version!r} is not read: {why}")
+  _check_finite(record, source)
+  error = schema_exceptions.best_match(
+      jsonschema.Draft202012Validator(schema()).iter_errors(record))
+  if error is not None:
+    raise RecordError(f"{source}: {_describe(error)}")
+  if record[INTEGRITY_FIELD] != content_sha256(record):
+    raise RecordError(f"{source}: content does not match its {INTEGRITY_FIELD} (edited after "
+                      f"softbench run wrote it?); records must not be edited by hand")
+  _check_consistency(record, source)
+
+
+def _where(path) -> str:
+  where = ""
+  for part in path:
+    where += f"[{part}]" if isinstance(part, int) else (f".{part}" if where else str(part))
+  return where or "record"
+
+
+def _describe(error: schema_exceptions.ValidationError) -> str:
+  if "additionalProperties" in error.schema_path:
+    return (f"{_where(error.absolute_path)}: unknown field (extra fields must be sections, "
+            f"JSON objects): {error.message}"[:_MAX_MESSAGE_CHARS])
+  message = error.message
+  if len(message) > _MAX_MESSAGE_CHARS:
+    message = message[:_MAX_MESSAGE_CHARS - 3] + "..."
+  return f"{_where(error.absolute_path)}: {message}"
+
+
+def _check_finite(value: object, source: str, path: tuple = ()) -> None:
+  if isinstance(value, float) and not math.isfinite(value):
+    raise RecordError(f"{source}: {_where(path)}: {value} is not a finite number")
+  if isinstance(value, dict):
+    for key, item in value.items():
+      _check_finite(item, source, path + (key,))
+  elif isinstance(value, list):
+    for index, item in enumerate(value):
+      _check_finite(item, source, path + (index,))
+
+
+def _check_consistency(record: dict, source: str) -> None:
+  """What the schema cannot say: counts that must agree, means that must follow."""
+  def refuse(message: str) -> None:
+    raise RecordError(f"{source}: {message}")
+
+  per_seed = record["per_seed"]
+  if len(per_seed) != record["seeds"]:
+    refuse(f"seeds is {record['seeds']} but per_seed has {len(per_seed)} entries")
+  numbers = [entry["seed"] for entry in per_seed]
+  if len(set(numbers)) != len(numbers):
+    refuse(f"per_seed repeats a seed ({numbers})")
+  try:
+    num_modules = robots.make(record["robot"]).num_modules
+  except ValueError as error:
+    refuse(f"robot: {error}")
+  if max(record["scored_modules"]) > num_modules:
+    refuse(f"scored_modules {record['scored_modules']} name a module beyond {record['robot']}'s "
+           f"{num_modules}")
+  if record["profile_settings"]["name"] != record["profile"]:
+    refuse(f"profile_settings.name {record['profile_settings']['name']!r} is not the profile "
+           f"{record['profile']!r}")
+  if (record["trajectory"] is None) == (record["task"] == "custom"):
+    refuse("trajectory goes with task custom, and task custom needs one")
+  try:
+    date = datetime.datetime.fromisoformat(record["date"])
+  except ValueError:
+    refuse(f"date {record['date']!r} is not an ISO 8601 date and time")
+  if date.tzinfo is None:
+    refuse(f"date {record['date']!r} has no time zone")
+  measured = [name for name in METRICS if name in per_seed[0]]
+  for index, entry in enumerate(per_seed):
+    if [name for name in METRICS if name in entry] != measured:
+      refuse(f"per_seed[{index}] has metrics {[n for n in METRICS if n in entry]}, per_seed[0] "
+             f"has {measured}")
+    for name in measured:
+      where = f"per_seed[{index}].{name}"
+      for field in ("per_module", "per_module_std_over_steps"):
+        if len(entry[name][field]) != len(record["scored_modules"]):
+          refuse(f"{where}.{field} has {len(entry[name][field])} values for "
+                 f"{len(record['scored_modules'])} scored modules")
+      expected = math.fsum(entry[name]["per_module"]) / len(entry[name]["per_module"])
+      if not math.isclose(entry[name]["mean"], expected, rel_tol=_MEAN_TOLERANCE,
+                          abs_tol=_MEAN_TOLERANCE):
+        refuse(f"{where}.mean {entry[name]['mean']} is not the mean of its per_module values "
+               f"({expected})")

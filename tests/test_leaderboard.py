@@ -1,0 +1,257 @@
+"""Result records (schema, integrity hash) and the leaderboard (ranking, markdown and HTML pages).
+
+One real record comes from ``softbench run``'s ``execute`` (the zero agent, tiny profile); the
+others are variants of it (another agent, date or scale of the errors), sealed again.
+"""
+
+import copy
+import json
+import math
+import pathlib
+import warnings
+
+import jsonschema
+import numpy as np
+import pytest
+from scipy import stats
+
+from softbench import cli
+from softbench import leaderboard
+from softbench import run
+from softbench.leaderboard import ranking
+from softbench.leaderboard import records
+
+
+@pytest.fixture(scope="module")
+def real_record(tmp_path_factory) -> dict:
+  """A 2-seed record of the zero agent on tendon-1 circle, as ``softbench run`` makes it."""
+  with pytest.MonkeyPatch.context() as patch:
+    patch.setenv("SOFTBENCH_HOME", str(tmp_path_factory.mktemp("leaderboard_home")))
+    settings = run.settings("circle", "zero", "tendon-1", seeds=2, profile="tiny")
+    return run.execute(settings, show_progress=False, workers=1)
+
+
+def variant(record: dict, agent: str | None = None, date: str | None = None, scale: float = 1.0,
+            **fields) -> dict:
+  """A sealed copy of ``record`` with another agent or date, ``fields`` replaced (``None``
+  removes one), then errors times ``scale``."""
+  changed = copy.deepcopy(record)
+  changed["agent"] = agent or changed["agent"]
+  changed["date"] = date or changed["date"]
+  for name, value in copy.deepcopy(fields).items():
+    if value is None:
+      changed.pop(name, None)
+    else:
+      changed[name] = value
+  for seed in changed["per_seed"]:
+    for name in records.METRICS:
+      if name in seed:
+        seed[name]["per_module"] = [value * scale for value in seed[name]["per_module"]]
+        seed[name]["mean"] = float(np.mean(seed[name]["per_module"]))
+  return records.seal(changed)
+
+
+def position_only(record: dict) -> dict:
+  """``record`` as if the task had been ``reach`` (no orientation error), unsealed."""
+  changed = copy.deepcopy(record)
+  changed["task"] = "reach"
+  for seed in changed["per_seed"]:
+    del seed["orientation_deg"]
+  return changed
+
+
+def write_raw(record: dict, path: pathlib.Path, reseal: bool = True) -> pathlib.Path:
+  """Writes ``record`` without checking it; ``reseal`` recomputes the hash of its content first,
+  so that a check other than the hash refuses it."""
+  record = dict(record)
+  if reseal:
+    record[records.INTEGRITY_FIELD] = records.content_sha256(record)
+  path.write_text(json.dumps(record, indent=2))
+  return path
+
+
+def test_schema_round_trip(real_record, tmp_path):
+  path = tmp_path / "record.json"
+  sealed = run.write_record(real_record, path)
+  assert sealed[records.INTEGRITY_FIELD] == records.content_sha256(real_record)
+  assert path.read_text() == records.dumps(sealed)
+  assert records.read(path) == sealed
+  assert records.seal(sealed) == sealed  # Sealing again changes nothing.
+  assert sealed["version"] == records.VERSION == run.RECORD_VERSION
+  schema = records.schema()
+  jsonschema.Draft202012Validator.check_schema(schema)  # Usable by any JSON Schema tool...
+  jsonschema.validate(sealed, schema)  # ...which accepts what softbench writes.
+  reach = records.seal(position_only(real_record))
+  assert records.read(write_raw(reach, tmp_path / "reach.json", reseal=False)) == reach
+
+
+def _tamper(record):
+  record["per_seed"][0]["position_mm"]["per_module"][0] += 0.01
+
+
+def _set(path, value):
+  def change(record):
+    *parents, last = path
+    target = record
+    for key in parents:
+      target = target[key]
+    if value is None:
+      del target[last]
+    else:
+      target[last] = value
+  return change
+
+
+MALFORMED = {
+    "hand-edited number": (_tamper, False, "does not match its sha256"),
+    "no hash": (_set(["sha256"], None), False, "'sha256' is a required property"),
+    "missing field": (_set(["robot"], None), True, "'robot' is a required property"),
+    "negative error": (_set(["per_seed", 0, "position_mm", "mean"], -1.0), True,
+                       r"per_seed\[0\].position_mm.mean: -1.0 is less than the minimum of 0"),
+    "NaN": (_set(["per_seed", 1, "mean_reward"], math.nan), False, "not a finite number"),
+    "unknown task": (_set(["task"], "juggle"), True, "'juggle' is not one of"),
+    "extra scalar field": (_set(["score"], 3), True, "score: unknown field"),
+    "old version": (_set(["version"], 1), True, "record version 1 is not read"),
+    "other format": (_set(["format"], "csv"), True, "not a result record"),
+    "seed count": (_set(["seeds"], 3), True, "seeds is 3 but per_seed has 2 entries"),
+    "repeated seed": (_set(["per_seed", 1, "seed"], 0), True, "repeats a seed"),
+    "module count": (_set(["per_seed", 0, "position_mm", "per_module"], [1.0, 1.0]), True,
+                     "has 2 values for 1 scored modules"),
+    "mean over modules": (_set(["per_seed", 0, "normalised_tip_percent", "mean"], 123.0), True,
+                          "is not the mean of its per_module values"),
+    "module beyond the robot": (_set(["scored_modules"], [2]), True, "beyond tendon-1's 1"),
+    "robot": (_set(["robot"], "tendon-0"), True, "robot: "),
+    "trajectory": (_set(["trajectory"], "path.csv"), True, "trajectory goes with task custom"),
+    "date": (_set(["date"], "yesterday"), True, "not an ISO 8601 date"),
+}
+
+
+@pytest.mark.parametrize("case", MALFORMED)
+def test_a_malformed_or_edited_record_is_refused_with_one_line(case, real_record, tmp_path):
+  change, reseal, message = MALFORMED[case]
+  record = records.seal(real_record)
+  change(record)
+  path = write_raw(record, tmp_path / "bad.json", reseal)
+  with pytest.raises(records.RecordError, match=message) as raised:
+    records.read(path)
+  assert str(raised.value).startswith(f"{path}: ") and "\n" not in str(raised.value)
+
+
+def test_the_cli_refuses_a_folder_with_a_bad_record(real_record, tmp_path, capsys):
+  run.write_record(real_record, tmp_path / "good.json")
+  bad = records.seal(real_record)
+  _tamper(bad)
+  write_raw(bad, tmp_path / "edited.json", reseal=False)
+  (tmp_path / "broken.json").write_text("{\"format\": ")
+  assert cli.main(["leaderboard", "--results", str(tmp_path)]) == cli.EXIT_USAGE
+  lines = capsys.readouterr().err.strip().splitlines()
+  assert len(lines) == 1 and "broken.json: not valid JSON" in lines[0]  # Files in name order.
+  (tmp_path / "broken.json").unlink()
+  assert cli.main(["leaderboard", "--results", str(tmp_path)]) == cli.EXIT_USAGE
+  assert "edited.json: content does not match its sha256" in capsys.readouterr().err
+
+
+def test_run_refuses_to_write_a_malformed_record(real_record, tmp_path):
+  record = copy.deepcopy(real_record)
+  record["per_seed"][0]["position_mm"]["mean"] = math.inf
+  with pytest.raises(records.RecordError, match="not a finite number"):
+    run.write_record(record, tmp_path / "record.json")
+  assert not list(tmp_path.iterdir())
+
+
+def test_bootstrap_interval():
+  values = [3.0, 1.0, 4.0, 1.5, 5.0]
+  estimate = ranking.Estimate.of(values)
+  expected = stats.bootstrap((np.array(values),), np.mean, n_resamples=10_000,
+                             method="percentile", rng=np.random.default_rng(0))
+  assert estimate.interval == (expected.confidence_interval.low,
+                               expected.confidence_interval.high)
+  assert min(values) <= estimate.interval[0] < estimate.mean < estimate.interval[1] <= max(values)
+  assert (estimate.mean, estimate.std) == (np.mean(values), np.std(values))
+  assert ranking.Estimate.of([2.0]).interval is None
+  with warnings.catch_warnings():
+    warnings.simplefilter("error")
+    assert ranking.Estimate.of([2.0, 2.0]).interval == (2.0, 2.0)
+
+
+@pytest.fixture
+def results(real_record, tmp_path) -> pathlib.Path:
+  """A results folder: three agents, an older record of one, one seed only, a reach record, a
+  record with a fault section, and videos (a path and a URL)."""
+  folder = tmp_path / "results"
+  made = {
+      "zero-old.json": variant(real_record, date="2020-01-01T00:00:00+00:00", scale=0.1),
+      "zero.json": variant(real_record, video="videos/zero.mp4"),
+      "good.json": variant(real_record, agent="good", scale=0.5,
+                           video="https://example.org/good.mp4"),
+      "bad.json": variant(real_record, agent="bad", scale=2.0),
+      "single.json": variant(real_record, agent="single", scale=0.8, seeds=1,
+                             per_seed=real_record["per_seed"][:1]),
+      "reach.json": records.seal(position_only(real_record)),
+      "fault.json": variant(real_record, fault={"module": 1, "kind": "dead"}),
+  }
+  for name, record in made.items():
+    run.write_record(record, folder / name)
+  return folder
+
+
+def test_ranking(results):
+  board = leaderboard.build(results)
+  assert board.record_count == 7
+  titles = [group.title for group in board.groups]
+  assert titles == ["tendon-1 · circle", "tendon-1 · circle (with fault)", "tendon-1 · reach"]
+  circle = board.groups[0]
+  assert [entry.record["agent"] for entry in circle.entries] == ["good", "single", "zero", "bad"]
+  assert [entry.path.name for entry in circle.superseded] == ["zero-old.json"]
+  assert circle.entries[1].estimates["position_mm"].interval is None  # One seed.
+  assert circle.metrics == records.METRICS
+  assert board.groups[2].metrics == ("position_mm", "normalised_tip_percent")
+
+
+def test_pages_contain_every_record(results, tmp_path, capsys):
+  out = tmp_path / "site"
+  assert cli.main(["leaderboard", "--results", str(results), "--write", "--out", str(out)]) == 0
+  printed = capsys.readouterr().out
+  markdown = (out / "README.md").read_text()
+  page = (out / "index.html").read_text()
+  assert "superseded: zero-old.json" in printed
+  for path in results.glob("*.json"):
+    assert f"(<../results/{path.name}>)" in markdown
+    assert f'href="../results/{path.name}"' in page
+  for text in (printed, markdown, page):
+    assert "tendon-1 · circle (with fault)" in text and "tendon-1 · reach" in text
+  assert "(<../results/videos/zero.mp4>)" in markdown and 'href="../results/videos/zero.mp4"' in page
+  assert 'href="https://example.org/good.mp4"' in page
+  assert page.count("<table class=\"sortable\">") == 3 and page.count("<svg") == 3 + 3 + 2
+  assert "<link" not in page and "src=" not in page  # Self-contained: nothing to fetch.
+  good = ranking.Estimate.of([seed["position_mm"]["mean"] for seed in
+                              records.read(results / "good.json")["per_seed"]])
+  assert ranking.cell(good) in markdown and ranking.cell(good) in page
+
+
+def test_regenerating_is_deterministic(results, tmp_path):
+  first = leaderboard.write(leaderboard.build(results), results, tmp_path / "site")
+  contents = [path.read_bytes() for path in first]
+  leaderboard.write(leaderboard.build(results), results, tmp_path / "site")
+  assert [path.read_bytes() for path in first] == contents
+  moved = tmp_path / "elsewhere"
+  (moved / "results").mkdir(parents=True)
+  for path in sorted(results.glob("*.json"), reverse=True):
+    (moved / "results" / path.name).write_bytes(path.read_bytes())
+  again = leaderboard.write(leaderboard.build(moved / "results"), moved / "results",
+                            moved / "site")
+  assert [path.read_bytes() for path in again] == contents
+
+
+@pytest.mark.parametrize("make_folder", [False, True])
+def test_write_on_a_missing_or_empty_folder(make_folder, tmp_path, capsys):
+  results = tmp_path / "results"
+  if make_folder:
+    results.mkdir()
+  out = tmp_path / "site"
+  assert cli.main(["leaderboard", "--results", str(results), "--write", "--out", str(out)]) == 0
+  printed = capsys.readouterr().out
+  assert f"no result records in {results}" in printed
+  assert ("an empty folder" if make_folder else "no folder") in printed
+  for page in ("README.md", "index.html"):
+    assert "No result records yet" in (out / page).read_text()
