@@ -24,8 +24,14 @@ def softbench_home() -> pathlib.Path:
   return pathlib.Path(cache) / "softbench"
 
 
+_FILE_MODE = 0o666  # What open() requests for a new file.
+
+
 def write_atomically(path: pathlib.Path, content: str | bytes) -> None:
-  """Writes ``content`` (text or bytes) to ``path`` through a temporary file and a rename."""
+  """Writes ``content`` (text or bytes) to ``path`` through a temporary file and a rename.
+
+  The file gets the permissions a plain ``open`` would give (0666 less the umask), not the
+  owner-only mode of the temporary file."""
   path = pathlib.Path(path)
   path.parent.mkdir(parents=True, exist_ok=True)
   mode = "wb" if isinstance(content, bytes) else "w"
@@ -33,7 +39,14 @@ def write_atomically(path: pathlib.Path, content: str | bytes) -> None:
     f.write(content)
     f.flush()
     os.fsync(f.fileno())
+  os.chmod(f.name, _FILE_MODE & ~_umask())
   os.replace(f.name, path)
+
+
+def _umask() -> int:
+  current = os.umask(0)
+  os.umask(current)
+  return current
 
 
 def arrays_sha256(arrays: dict[str, np.ndarray]) -> str:

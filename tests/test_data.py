@@ -433,3 +433,11 @@ def test_normalisation_is_fitted_on_the_training_split_only(windowed):
 def test_split_without_room_for_a_window_raises_value_error():
   with pytest.raises(ValueError, match=r"train split \(15 samples\) holds no window"):
     data.windows(collect(), data.View.end_effector(robots.make(SMALL["robot"])))
+
+
+def test_atomic_writes_get_the_permissions_of_a_plain_open(tmp_path):
+  plain, atomic = tmp_path / "plain.txt", tmp_path / "atomic.txt"
+  plain.write_text("x")
+  storage.write_atomically(atomic, "x")
+  assert atomic.stat().st_mode == plain.stat().st_mode
+  assert not list(tmp_path.glob("*.tmp"))
