@@ -16,6 +16,7 @@ from softbench import suite
 from softbench.robots import export as model_export
 
 EXIT_USAGE = 2
+EXIT_FAILURE = 1  # The run itself failed (not the input).
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it.
 
 
@@ -200,6 +201,9 @@ def main(argv: list[str] | None = None) -> int:
   except (ValueError, FileNotFoundError, FloatingPointError) as error:
     print(f"softbench: error: {error}", file=sys.stderr)
     return EXIT_USAGE
+  except run_module.WorkerDied as error:
+    print(f"softbench: error: {error}", file=sys.stderr)
+    return EXIT_FAILURE
   except KeyboardInterrupt:
     print("softbench: interrupted; run the same command again to resume", file=sys.stderr)
     return EXIT_INTERRUPTED

@@ -6,6 +6,7 @@ errors per module are averaged over its steps, and the table gives their mean an
 deviation over seeds. Every run writes a result record with full provenance.
 """
 
+from concurrent import futures
 import dataclasses
 import datetime
 import multiprocessing
@@ -134,29 +135,42 @@ def _ignore_interrupts() -> None:
   signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
+class WorkerDied(RuntimeError):
+  """A worker process ended without a result (killed, or out of memory)."""
+
+
 def _parallel(function, arguments: list[tuple], label: str, workers: int) -> list:
   """``function(*args)`` for each entry of ``arguments`` in ``workers`` processes (one torch and
   MuJoCo thread each), with one progress bar; results in order.
 
-  On Ctrl-C the workers are terminated; seeds whose checkpoints were written are reused by the
-  next run."""
+  A worker's exception is raised here. On Ctrl-C, or when a worker dies, the workers are
+  terminated; seeds whose checkpoints were written are reused by the next run.
+
+  Raises:
+    WorkerDied: a worker process ended without a result.
+  """
   progress = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                       TimeElapsedColumn())
-  pool = multiprocessing.get_context("spawn").Pool(workers, initializer=_ignore_interrupts)
+  executor = futures.ProcessPoolExecutor(workers, multiprocessing.get_context("spawn"),
+                                         initializer=_ignore_interrupts)
   try:
     with progress:
       bar = progress.add_task(f"{label} ({workers} processes)", total=len(arguments))
-      pending = [pool.apply_async(function, entry) for entry in arguments]
-      while not all(result.ready() for result in pending):
-        time.sleep(_POLL_SECONDS)
-        progress.update(bar, completed=sum(result.ready() for result in pending))
-      outcomes = [result.get() for result in pending]  # Re-raises a worker's error.
+      pending = [executor.submit(function, *entry) for entry in arguments]
+      while futures.wait(pending, _POLL_SECONDS, futures.FIRST_EXCEPTION).not_done:
+        progress.update(bar, completed=sum(future.done() for future in pending))
+        if any(future.done() and future.exception() for future in pending):
+          break
+      outcomes = [future.result() for future in pending]  # Re-raises a worker's error.
       progress.update(bar, completed=len(arguments))
-    pool.close()
     return outcomes
+  except futures.process.BrokenProcessPool:
+    raise WorkerDied(f"a worker process of {label} ended without a result (killed, or out of "
+                     f"memory?); run the same command again to resume") from None
   finally:
-    pool.terminate()
-    pool.join()
+    for process in multiprocessing.active_children():  # The executor's workers.
+      process.terminate()
+    executor.shutdown(wait=True, cancel_futures=True)
 
 
 def over_seeds(function, seeds: int, arguments: tuple, label: str, show_progress: bool,

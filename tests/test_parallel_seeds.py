@@ -1,0 +1,68 @@
+"""Seeds in worker processes (``softbench.run``): results in order, errors raised, a dead worker
+reported instead of a hang, Ctrl-C stopping every worker."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from softbench import run
+
+
+def square(value):
+  return value * value
+
+
+def fail(value):
+  raise ValueError(f"bad seed {value}")
+
+
+def die(value):
+  os._exit(3)
+
+
+def test_results_come_back_in_order():
+  assert run._parallel(square, [(3,), (1,), (2,)], "squares", workers=2) == [9, 1, 4]
+
+
+def test_a_worker_error_is_raised():
+  with pytest.raises(ValueError, match="bad seed"):
+    run._parallel(fail, [(1,), (2,)], "failing", workers=2)
+
+
+def test_a_dead_worker_is_reported_not_waited_for():
+  started = time.perf_counter()
+  with pytest.raises(run.WorkerDied, match="ended without a result"):
+    run._parallel(die, [(1,), (2,)], "dying", workers=2)
+  assert time.perf_counter() - started < 60
+
+
+_INTERRUPTED_PROGRAM = """
+import sys, time
+sys.path.insert(0, {tests!r})
+from softbench import run
+import test_parallel_seeds
+try:
+  run._parallel(test_parallel_seeds.sleep_long, [(0,), (1,)], "sleepers", workers=2)
+except KeyboardInterrupt:
+  import multiprocessing
+  print("children left:", len(multiprocessing.active_children()), flush=True)
+"""
+
+
+def sleep_long(value):
+  print("worker started", flush=True)
+  time.sleep(600)
+
+
+def test_ctrl_c_stops_every_worker():
+  program = _INTERRUPTED_PROGRAM.format(tests=os.path.dirname(__file__))
+  process = subprocess.Popen([sys.executable, "-c", program], stdout=subprocess.PIPE, text=True)
+  assert process.stdout.readline().strip() == "worker started"
+  time.sleep(1.0)
+  process.send_signal(signal.SIGINT)
+  out, _ = process.communicate(timeout=60)
+  assert "children left: 0" in out
