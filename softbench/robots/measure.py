@@ -12,17 +12,12 @@ from mujoco import rollout
 
 from softbench.robots import base
 from softbench.robots import chain
+from softbench.robots import recorder
 
 SETTLE_SECONDS = 3.0  # (s) Time given to reach equilibrium after a change of action.
 SETTLED_TOLERANCE = 0.001  # (m) Tip distance from its final position that counts as settled.
 WORKSPACE_SAMPLES = 200  # Random actions whose poses outline the workspace.
 DISCRETISATION_REFINEMENT = 4  # The finer model has this many times more segments.
-
-
-def _state(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
-  state = np.empty(mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS))
-  mujoco.mj_getState(model, data, state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
-  return state
 
 
 def tip_trajectory(robot: base.SoftArm, actions: np.ndarray, hold_seconds: float,
@@ -32,20 +27,14 @@ def tip_trajectory(robot: base.SoftArm, actions: np.ndarray, hold_seconds: float
   Raises:
     FloatingPointError: the simulation became unstable.
   """
-  model = model if model is not None else robot.compile()
-  data = mujoco.MjData(model)
-  steps = int(round(hold_seconds / model.opt.timestep))
+  poses = recorder.PoseRecorder(robot, model=model)
+  data = mujoco.MjData(poses.model)
+  steps = int(round(hold_seconds / poses.model.opt.timestep))
   controls = np.repeat(robot.action_to_ctrl(np.atleast_2d(actions)), steps, axis=0)
-  sites = [model.site(chain.tip_site_name(k)).id for k in range(1, robot.num_modules + 1)]
-  states, _ = rollout.rollout(model, data, _state(model, data)[None], controls[None])
+  states, _ = rollout.rollout(poses.model, data, poses.rest_state()[None], controls[None])
   if data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number or not np.all(np.isfinite(states)):
     raise FloatingPointError(f"{robot.name}: simulation unstable")
-  positions = np.empty((len(controls), len(sites), 3))
-  for step, state in enumerate(states[0]):
-    mujoco.mj_setState(model, data, state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
-    mujoco.mj_kinematics(model, data)
-    positions[step] = data.site_xpos[sites]
-  return positions
+  return poses.poses(states[0])[..., :3]
 
 
 def equilibrium(robot: base.SoftArm, action: np.ndarray, seconds: float = SETTLE_SECONDS,
@@ -102,9 +91,9 @@ def simulation_speed(robot: base.SoftArm, seconds: float = 5.0, seed: int = 0) -
   actions = np.random.default_rng(seed).uniform(-1, 1, (periods, robot.action_dim))
   steps = int(round(robot.control_timestep / model.opt.timestep))
   controls = np.repeat(robot.action_to_ctrl(actions), steps, axis=0)[None]
-  data = mujoco.MjData(model)
+  data, initial = mujoco.MjData(model), recorder.PoseRecorder(robot, model=model).rest_state()
   start = time.perf_counter()
-  rollout.rollout(model, data, _state(model, data)[None], controls)
+  rollout.rollout(model, data, initial[None], controls)
   elapsed = time.perf_counter() - start
   return {"steps_per_second": controls.shape[1] / elapsed,
           "real_time_factor": controls.shape[1] * model.opt.timestep / elapsed}

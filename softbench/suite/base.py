@@ -40,11 +40,6 @@ class SoftArmTask(suite_base.Task):
     self._previous_action = None
     self._step = 0
 
-  @property
-  def step_index(self) -> int:
-    """Control steps taken in the current episode."""
-    return self._step
-
   target_size = 6  # Entries of one module's target: position and orientation vector.
 
   def targets_at(self, step: int) -> np.ndarray:
