@@ -121,7 +121,7 @@ def _settled_error_mm(tips: np.ndarray, target: np.ndarray, steps: int) -> float
 def reach_target(agent: learned.LearnedAgent, robot: robot_base.SoftArm, target_seed: int,
                  module: int, stages: Timing, threshold: float) -> TargetOutcome:
   """Runs the staged procedure on the target of ``target_seed`` (module docstring), then the
-  all-on comparison, with ``threshold`` in mm."""
+  all-on comparison, with ``threshold`` in mm and the agent's own ``helper_targets``."""
   staged = procedure.ActivationProcedure(robot.num_modules, module, threshold)
   env = suite.load(robot, "reach", seed=target_seed, module=module,
                    steps=staged.max_stages * stages.stage_steps)

@@ -9,6 +9,7 @@ import pathlib
 import matplotlib
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
+from matplotlib.ticker import MaxNLocator
 
 from softbench import storage
 
@@ -52,7 +53,9 @@ def _path_panel(axes, path: dict, colours: dict) -> None:
   axes.plot(*zip(*path["all_on_path_mm"]), color="0.6", linewidth=1, linestyle="--")
   axes.scatter(*[[value] for value in points[0]], color="black", s=15)
   axes.scatter(*[[value] for value in path["target_mm"]], color="red", marker="*", s=80)
-  axes.set_aspect("equal")
+  axes.set_aspect("equal")  # True geometry; few ticks on an axis the path hardly spans.
+  for axis in (axes.xaxis, axes.yaxis, axes.zaxis):
+    axis.set_major_locator(MaxNLocator(4))
   axes.set_title(f"target {path['target_seed']}", fontsize=9)
   axes.set_xlabel("x (mm)", fontsize=8)
   axes.set_ylabel("y (mm)", fontsize=8)
