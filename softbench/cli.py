@@ -5,6 +5,7 @@ import argparse
 import pathlib
 import sys
 
+from softbench import adaptive
 from softbench import agents
 from softbench import continual
 from softbench import data
@@ -13,6 +14,7 @@ from softbench import profiles
 from softbench import robots
 from softbench import run as run_module
 from softbench import suite
+from softbench.adaptive import plot as adaptive_plot
 from softbench.robots import export as model_export
 
 EXIT_USAGE = 2
@@ -108,12 +110,15 @@ def _run(args: argparse.Namespace) -> None:
   if args.task is None:
     raise ValueError("softbench run needs --task TASK (or --protocol exp1s)")
   settings = run_module.settings(args.task, args.agent, args.robot, args.seeds, args.profile,
-                                 args.eval, args.trajectory)
+                                 args.eval, args.trajectory, args.module, args.adaptive,
+                                 args.targets, args.helpers)
   record = run_module.execute(settings)
   print(run_module.table(record))
   path = run_module.record_path(record, pathlib.Path(args.results))
   run_module.write_record(record, path)
   print(f"result record: {path}")
+  if settings.adaptive:
+    print(f"plot: {adaptive_plot.write(record, path.with_suffix('.png'))}")
   if args.json:
     run_module.write_record(record, pathlib.Path(args.json))
 
@@ -167,6 +172,17 @@ def build_parser() -> argparse.ArgumentParser:
   run_parser.add_argument("--eval", default="physics", help="physics (default), model or "
                                                             "open-loop: the error fed back")
   run_parser.add_argument("--trajectory", help="target poses for --task custom (.npy or .csv)")
+  run_parser.add_argument("--module", type=int,
+                          help="the module that reaches (--task reach; default 2)")
+  run_parser.add_argument("--adaptive", action="store_true",
+                          help="--task reach with adaptive module activation: the reaching "
+                               "module alone, then its neighbours while they lower the error")
+  run_parser.add_argument("--targets", type=int,
+                          help=f"virtual targets of --adaptive (default "
+                               f"{adaptive.DEFAULT_TARGETS})")
+  run_parser.add_argument("--helpers", help="what --adaptive asks of the other active modules: "
+                                            "share (default; the reaching module's error) or "
+                                            "hold (their starting pose)")
   run_parser.add_argument("--results", default="leaderboard/results",
                           help="folder of the result records (default leaderboard/results)")
   run_parser.add_argument("--json", help="also write the result record to this file")

@@ -4,6 +4,10 @@ For each seed the agent is built (learned agents train on the robot's babbling d
 cached), then acts on one episode of the task (environment seed = the same seed); the episode's
 errors per module are averaged over its steps, and the table gives their mean and standard
 deviation over seeds. Every run writes a result record with full provenance.
+
+With ``adaptive`` (task ``reach``, a learned agent), one agent (seed 0) reaches ``targets``
+virtual targets with adaptive module activation instead (``softbench.adaptive``); the record
+then holds an ``adaptive`` section and no per-seed scores.
 """
 
 from concurrent import futures
@@ -22,6 +26,7 @@ import torch
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 import softbench
+from softbench import adaptive as adaptive_activation
 from softbench import agents
 from softbench import data
 from softbench import evaluation
@@ -32,6 +37,7 @@ from softbench import suite
 from softbench.agents import learned
 from softbench.data import dataset
 from softbench.leaderboard import records
+from softbench.suite import reach
 
 PAPER_ROBOT = {"babbling": "tendon-3", "circle": "tendon-3", "rectangle": "tendon-3",
                "spiral": "tendon-3", "custom": "tendon-3", "reach": "pneumatic-433"}
@@ -53,39 +59,74 @@ class RunSettings:
   profile: profiles.Profile
   eval_mode: str
   trajectory: str | None = None
+  module: int | None = None  # The reaching module (task reach); None: the task's default.
+  adaptive: bool = False
+  targets: int | None = None  # Virtual targets of an adaptive run.
+  helpers: str | None = None  # Targets of the other modules in an adaptive run.
 
 
 def settings(task: str, agent: str, robot: str | None = None, seeds: int | None = None,
              profile: str = profiles.DEFAULT_PROFILE, eval_mode: str = "physics",
-             trajectory: str | None = None) -> RunSettings:
+             trajectory: str | None = None, module: int | None = None, adaptive: bool = False,
+             targets: int | None = None, helpers: str | None = None) -> RunSettings:
   """Checked settings, with the defaults filled in.
 
   Raises:
     ValueError: unknown task, agent, robot, profile or eval mode, seeds < 1, a trajectory
-      without the custom task or the custom task without one (one line).
+      without the custom task or the custom task without one, a module with another task than
+      reach or out of range, adaptive with another task than reach, a non-learned agent or
+      more than one seed, targets or helpers without adaptive, targets < 1, unknown helpers
+      (one line).
   """
   suite.describe(task)
   agents.describe(agent)
   chosen = profiles.get(profile)
   robot = robot or PAPER_ROBOT[task]
   robots.make(robot)
-  seeds = chosen.seeds if seeds is None else seeds
+  _check_adaptive(task, agent, robot, seeds, module, adaptive, targets, helpers)
+  seeds = (1 if adaptive else chosen.seeds) if seeds is None else seeds
   dataset.check_count("seeds", seeds)
   if eval_mode not in learned.ERROR_SOURCES:
     raise ValueError(f"unknown eval mode {eval_mode!r}; choose one of "
                      f"{', '.join(learned.ERROR_SOURCES)}")
   if (trajectory is None) == (task == "custom"):
     raise ValueError("--trajectory goes with --task custom, and --task custom needs one")
+  if adaptive:
+    targets = adaptive_activation.DEFAULT_TARGETS if targets is None else targets
+    helpers = adaptive_activation.experiment.DEFAULT_HELPERS if helpers is None else helpers
   return RunSettings(task, agent, robot, seeds, chosen, eval_mode,
-                     None if trajectory is None else str(trajectory))
+                     None if trajectory is None else str(trajectory), module, adaptive, targets,
+                     helpers)
+
+
+def _check_adaptive(task: str, agent: str, robot: str, seeds: int | None, module: int | None,
+                    adaptive: bool, targets: int | None, helpers: str | None) -> None:
+  """The checks of ``--module``, ``--adaptive``, ``--targets`` and ``--helpers``."""
+  if module is not None and task != "reach":
+    raise ValueError("--module goes with --task reach")
+  if module is not None:
+    reach.check_module(robots.make(robot), module)
+  if adaptive and task != "reach":
+    raise ValueError(f"--adaptive goes with --task reach, not {task!r}: it reaches a point")
+  if adaptive and not agents.describe(agent).learned:
+    raise ValueError(f"--adaptive needs a learned agent, not {agent!r}")
+  if adaptive and seeds not in (None, 1):
+    raise ValueError("--adaptive uses one trained agent (seed 0); vary --targets, not --seeds")
+  if (targets is not None or helpers is not None) and not adaptive:
+    raise ValueError("--targets and --helpers go with --adaptive")
+  if targets is not None:
+    dataset.check_count("targets", targets)
+  if helpers is not None:
+    adaptive_activation.experiment.check_helpers(helpers)
 
 
 def _task_options(run: RunSettings) -> dict:
   if run.task == "custom":
     return {"trajectory": run.trajectory}
+  options = {} if run.module is None else {"module": run.module}
   if run.profile.episode_length is None:
-    return {}
-  return {"steps" if run.task == "reach" else "length": run.profile.episode_length}
+    return options
+  return {**options, "steps" if run.task == "reach" else "length": run.profile.episode_length}
 
 
 def _seed_scores(score: metrics.TrackingScore) -> dict:
@@ -199,14 +240,21 @@ def execute(run: RunSettings, show_progress: bool = True, workers: int | None = 
   if agents.describe(run.agent).learned:
     data.collect(run.robot, samples=run.profile.samples, seed=learned.DATA_SEED,
                  progress=show_progress)
-  outcomes = over_seeds(_run_seed, run.seeds, (run,), f"{run.agent} on {run.task}",
-                         show_progress, workers)
+  if run.adaptive:
+    section = adaptive_activation.run(run.robot, run.agent, run.profile, run.targets,
+                                      run.module, run.eval_mode, run.helpers, show_progress)
+    results = {"scored_modules": [section["target_module"]], "per_seed": [],
+               "adaptive": section}
+  else:
+    outcomes = over_seeds(_run_seed, run.seeds, (run,), f"{run.agent} on {run.task}",
+                          show_progress, workers)
+    results = {"scored_modules": list(outcomes[0][1]),
+               "per_seed": [entry for entry, _ in outcomes]}
   return {
       "format": RECORD_FORMAT, "version": RECORD_VERSION, **origin,
       "robot": run.robot, "task": run.task, "agent": run.agent, "profile": run.profile.name,
       "profile_settings": dataclasses.asdict(run.profile), "eval_mode": run.eval_mode,
-      "trajectory": run.trajectory, "seeds": run.seeds,
-      "scored_modules": list(outcomes[0][1]), "per_seed": [entry for entry, _ in outcomes],
+      "trajectory": run.trajectory, "seeds": run.seeds, **results,
       "wall_time_s": round(time.perf_counter() - started, 3),
   }
 
@@ -220,7 +268,10 @@ def summary(record: dict, metric: str) -> tuple[list[metrics.Statistic], metrics
 
 
 def table(record: dict) -> str:
-  """The printed table: rows per scored module and their mean, columns per metric."""
+  """The printed table: rows per scored module and their mean, columns per metric (an adaptive
+  run: ``softbench.adaptive.report.table``)."""
+  if "adaptive" in record:
+    return adaptive_activation.report.table(record)
   measured = [(name, label) for name, label in METRICS if name in record["per_seed"][0]]
   columns = {name: summary(record, name) for name, _ in measured}
   rows = [f"module {module}" for module in record["scored_modules"]] + ["mean"]
@@ -245,7 +296,8 @@ def date_stamp(record: dict) -> str:
 
 
 def record_path(record: dict, results: pathlib.Path) -> pathlib.Path:
-  return results / (f"{record['agent']}-{record['robot']}-{record['task']}-{record['profile']}-"
+  task = record["task"] + ("-adaptive" if "adaptive" in record else "")
+  return results / (f"{record['agent']}-{record['robot']}-{task}-{record['profile']}-"
                     f"{record['eval_mode']}-{date_stamp(record)}.json")
 
 

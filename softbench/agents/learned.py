@@ -12,9 +12,20 @@ Acting, at control step t, each controller reads (normalised with its training s
 
 where x*_{t+1} is this step's target and x*_t the previous one; e_0 = 0 and a_{-1} = 0 (SPEC 5).
 ``error_source`` chooses e_t: ``physics`` (the headline), ``model`` (x_t replaced by the forward
-model's prediction, the paper's protocol) or ``open-loop`` (e_t = 0). Unscored modules (reach)
-hold their starting pose as target; a position-only target keeps the module's starting
-orientation, as in the paper's reaching experiment.
+model's prediction, the paper's protocol) or ``open-loop`` (e_t = 0). A position-only target
+keeps the module's starting orientation, as in the paper's reaching experiment. The modules a
+task does not score (reach) get targets by ``helper_targets``: ``hold`` (default) holds each at
+its starting pose; ``share`` (adaptive activation) gives every active one the scored module's
+remaining position error, as its pose now shifted by that error, and asks every inactive one
+for nothing (its pose now).
+
+``active_modules`` (1-based; None: every module) switches modules off: their action entries are
+zero (passive: no cable tension, zero pressure). The model still computes every output, so an
+SMPL column of an inactive module keeps running as an observer of its module, on its real pose,
+target, error and the zero action it actually received; the active columns read it through the
+lateral connections as they were trained to. A centralised baseline is masked the same way,
+which keeps comparisons fair (``softbench.adaptive``). With every module active the actions are
+those of the unmasked agent, bit for bit.
 """
 
 import contextlib
@@ -40,6 +51,7 @@ from softbench.agents import base
 from softbench.robots import base as robot_base
 
 ERROR_SOURCES = ("physics", "model", "open-loop")
+HELPER_TARGETS = ("hold", "share")
 CHECKPOINT_FOLDER = "checkpoints"
 DATA_SEED = 0  # Every agent and seed learns from the same babbling dataset.
 TRAINING_VERSION = 2  # Bump when training changes, so cached checkpoints are not reused. 2: SMPL
@@ -93,6 +105,8 @@ class LearnedAgent(base.Agent):
     self.inverse = inverse
     self.controllers = controllers
     self.error_source = error_source
+    self.active_modules: tuple[int, ...] | None = None
+    self.helper_targets = "hold"
     self._reset_memory()
 
   def _reset_memory(self) -> None:
@@ -112,8 +126,16 @@ class LearnedAgent(base.Agent):
       controller.forward_state = controller.forward.initial_state(1)
     self._inverse_state = self.inverse.initial_state(1)
 
-  def _full_target(self, target: np.ndarray) -> np.ndarray:
+  def _full_target(self, target: np.ndarray, poses: np.ndarray) -> np.ndarray:
+    """Every module's target pose (module docstring: ``helper_targets``)."""
+    if self.helper_targets not in HELPER_TARGETS:
+      raise ValueError(f"helper_targets must be one of {', '.join(HELPER_TARGETS)}, "
+                       f"got {self.helper_targets!r}")
     full = self._start_poses.copy()
+    if self.helper_targets == "share" and len(self._scored) == 1:
+      full = poses.copy()
+      full[self._module_active(), :3] += target[0, :3] - poses[self._scored[0], :3]
+      full[self._scored] = self._start_poses[self._scored]
     full[self._scored, :target.shape[1]] = target
     return full
 
@@ -122,7 +144,7 @@ class LearnedAgent(base.Agent):
     if self._start_poses is None:
       self._start_poses = poses.copy()
       self._previous_poses = self._poses_before = poses.copy()  # x_{-1} = x_{-2} = x_0
-    target = self._full_target(np.asarray(observation["target"], dtype=float))
+    target = self._full_target(np.asarray(observation["target"], dtype=float), poses)
     action = np.zeros(self.robot.action_dim)
     with torch.no_grad():
       inputs = [self._controller_inputs(controller, target, poses)
@@ -137,10 +159,22 @@ class LearnedAgent(base.Agent):
         action[list(controller.view.action_indices)] = controller.normalisation.actions.denormalise(
             output[0].numpy().astype(float))
     action = np.clip(action, -1.0, 1.0)
+    action[~np.repeat(self._module_active(), self.robot.actuators_per_module)] = 0.0
     self._previous_target = target
     self._poses_before, self._previous_poses = self._previous_poses, poses
     self._previous_action = action
     return action
+
+  def _module_active(self) -> np.ndarray:
+    """(num_modules,) whether each module acts (``active_modules``)."""
+    active = np.ones(self.robot.num_modules, dtype=bool)
+    if self.active_modules is not None:
+      if not set(self.active_modules) <= set(range(1, self.robot.num_modules + 1)):
+        raise ValueError(f"active modules must lie in 1 to {self.robot.num_modules} for "
+                         f"{self.robot.name}, got {tuple(self.active_modules)}")
+      active[:] = False
+      active[np.array(list(self.active_modules), dtype=int) - 1] = True
+    return active
 
   def _controller_inputs(self, controller: Controller, target: np.ndarray,
                          poses: np.ndarray) -> torch.Tensor:

@@ -138,6 +138,8 @@ def rank(loaded: list[tuple[pathlib.Path, dict]]) -> Leaderboard:
   """The leaderboard of checked records (``records.read_folder``)."""
   by_group: dict[tuple[str, str, str], list[Entry]] = {}
   for path, record in loaded:
+    if not record["per_seed"]:  # Adaptive activation: its own report (softbench.adaptive).
+      continue
     by_group.setdefault(_group_key(record), []).append(Entry.of(path, record))
   groups = []
   for key in sorted(by_group, key=lambda k: (_robot_order(k[0]), suite.TASKS.index(k[1]), k[2])):

@@ -36,6 +36,7 @@ METRICS = ("position_mm", "orientation_deg", "normalised_tip_percent")
 """Errors a record may hold per seed; position and normalised tip error always, orientation
 except for position-only tasks (reach)."""
 _OPTIONAL_FIELDS = ("video",)
+ADAPTIVE_SECTION = "adaptive"  # softbench run --adaptive: per-target results, no per-seed ones.
 _MEAN_TOLERANCE = 1e-9  # Relative: a seed's mean against the mean of its per-module values.
 _MAX_MESSAGE_CHARS = 160  # Of a schema error's message, so that a refusal stays one line.
 
@@ -78,7 +79,7 @@ def schema() -> dict:
       "seeds": {"type": "integer", "minimum": 1},
       "scored_modules": {"type": "array", "items": {"type": "integer", "minimum": 1},
                          "minItems": 1, "uniqueItems": True},
-      "per_seed": {"type": "array", "items": seed, "minItems": 1},
+      "per_seed": {"type": "array", "items": seed},
       "wall_time_s": non_negative,
       "date": {"type": "string", "format": "date-time"},
       "machine": {"type": "object"},
@@ -232,7 +233,11 @@ def _check_consistency(record: dict, source: str) -> None:
     raise RecordError(f"{source}: {message}")
 
   per_seed = record["per_seed"]
-  if len(per_seed) != record["seeds"]:
+  if ADAPTIVE_SECTION in record:
+    if per_seed:
+      refuse(f"an {ADAPTIVE_SECTION} record holds its scores in that section; per_seed must be "
+             f"empty")
+  elif len(per_seed) != record["seeds"]:
     refuse(f"seeds is {record['seeds']} but per_seed has {len(per_seed)} entries")
   numbers = [entry["seed"] for entry in per_seed]
   if len(set(numbers)) != len(numbers):
@@ -255,7 +260,7 @@ def _check_consistency(record: dict, source: str) -> None:
     refuse(f"date {record['date']!r} is not an ISO 8601 date and time")
   if date.tzinfo is None:
     refuse(f"date {record['date']!r} has no time zone")
-  measured = [name for name in METRICS if name in per_seed[0]]
+  measured = [name for name in METRICS if per_seed and name in per_seed[0]]
   for index, entry in enumerate(per_seed):
     if [name for name in METRICS if name in entry] != measured:
       refuse(f"per_seed[{index}] has metrics {[n for n in METRICS if n in entry]}, per_seed[0] "

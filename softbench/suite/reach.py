@@ -17,6 +17,18 @@ TARGET_SETTLE_SECONDS = 3.0  # (s) Time the target-defining action is held; long
 DEFAULT_MODULE = 2  # The paper's reaching experiment moves module 2 (module 1 on a 1-module arm).
 
 
+def check_module(robot: robot_base.SoftArm, module: int | None) -> int:
+  """The module that reaches: ``module``, or ``DEFAULT_MODULE`` if None.
+
+  Raises:
+    ValueError: ``module`` is not one of the robot's modules (one line).
+  """
+  module = min(DEFAULT_MODULE, robot.num_modules) if module is None else module
+  if isinstance(module, bool) or not isinstance(module, int) or not 1 <= module <= robot.num_modules:
+    raise ValueError(f"module must be 1 to {robot.num_modules} for {robot.name}, got {module!r}")
+  return module
+
+
 class Reach(base.SoftArmTask):
   """Bring module ``module``'s tip to a random reachable point within ``steps`` control steps."""
 
@@ -26,9 +38,7 @@ class Reach(base.SoftArmTask):
                steps: int | None = None, initial_actuation: float = base.INITIAL_ACTUATION,
                random=None):
     super().__init__(robot, initial_actuation, random)
-    module = min(DEFAULT_MODULE, robot.num_modules) if module is None else module
-    if not (isinstance(module, int) and 1 <= module <= robot.num_modules):
-      raise ValueError(f"module must be 1 to {robot.num_modules} for {robot.name}, got {module!r}")
+    module = check_module(robot, module)
     default_steps = int(round(REACH_SECONDS / robot.control_timestep))
     steps = default_steps if steps is None else steps
     if not (isinstance(steps, int) and steps >= 1):
