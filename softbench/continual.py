@@ -190,7 +190,7 @@ def task_options(profile: profiles.Profile) -> dict:
 
 
 RECORD_FORMAT = "softbench-exp1s-result"
-RECORD_VERSION = 1
+RECORD_VERSION = 2  # 2: sealed with an integrity hash (softbench.leaderboard.exp1s_records).
 
 
 def execute(profile: profiles.Profile, seeds: int | None = None, show_progress: bool = True,
