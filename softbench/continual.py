@@ -21,14 +21,11 @@ import pathlib
 import time
 
 import numpy as np
-import torch
 
 from smpl import checkpoint
-from smpl import forward_model as smpl_forward
 from smpl import progressive
 from smpl import protocol as smpl_protocol
 from smpl import training
-from smpl import windows as smpl_windows
 from softbench import data
 from softbench import evaluation
 from softbench import metrics
@@ -190,7 +187,7 @@ def task_options(profile: profiles.Profile) -> dict:
 
 
 RECORD_FORMAT = "softbench-exp1s-result"
-RECORD_VERSION = 1
+RECORD_VERSION = 2  # 2: sealed with an integrity hash (softbench.leaderboard.exp1s_records).
 
 
 def execute(profile: profiles.Profile, seeds: int | None = None, show_progress: bool = True,

@@ -21,7 +21,6 @@ import signal
 import subprocess
 import time
 
-import numpy as np
 import torch
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
@@ -302,6 +301,7 @@ def record_path(record: dict, results: pathlib.Path) -> pathlib.Path:
 
 
 def write_record(record: dict, path: pathlib.Path) -> dict:
-  """Checks ``record`` against the schema, seals it with its integrity hash and writes it
-  atomically (``leaderboard.records.write``); returns the sealed record."""
+  """Checks ``record`` against the schema of its format (a run's, or Exp1S's), seals it with its
+  integrity hash and writes it atomically (``leaderboard.records.write``); returns the sealed
+  record."""
   return records.write(record, path)

@@ -9,6 +9,7 @@ import pytest
 from softbench import cli
 from softbench import continual
 from softbench import protocols
+from softbench.leaderboard import records
 
 STAGES = ("tendon-1", "tendon-2")
 
@@ -31,7 +32,8 @@ def test_exp1s_end_to_end(two_stages, tmp_path, capsys):
                   "closed loop, normalised tip error (%)", "forgetting matrix"):
     assert heading in out
   (path,) = results.glob("smpl-exp1s-tiny-*.json")
-  record = json.loads(path.read_text())
+  record = records.read(path)  # Checked: schema, integrity hash, consistency.
+  assert record == json.loads(path.read_text()) and record["version"] == continual.RECORD_VERSION
   assert record["robots"] == list(STAGES) and record["seeds"] == 1
   (seed,) = record["per_seed"]
   for loop in continual.LOOPS:

@@ -7,7 +7,6 @@ seconds; every test writes under its own temporary SOFTBENCH_HOME, never the rea
 import hashlib
 import json
 import pathlib
-import warnings
 
 import numpy as np
 import pytest
@@ -17,7 +16,6 @@ from smpl import windows as smpl_windows
 from softbench import data
 from softbench import robots
 from softbench import storage
-from softbench.data import babbling
 from softbench.data import chunks
 from softbench.data import dataset
 from softbench.robots import recorder

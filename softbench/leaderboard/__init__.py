@@ -1,8 +1,11 @@
 """The leaderboard: result records ranked per robot and task, printed and written as pages.
 
-``records`` (schema, integrity hash, checked reading and writing), ``ranking`` (newest record per
-agent, profile and eval mode; mean, std and bootstrap interval over seeds), ``text`` (the
-printout), ``markdown_page`` and ``html_page`` (``README.md`` and ``index.html``).
+``records`` (schema, integrity hash, checked reading and writing, for every kind of record),
+``record_fields`` (the fields every kind shares), ``exp1s_records`` (the Exp1S record's schema
+and checks), ``ranking`` (newest record per agent, profile and eval mode; mean, std and
+bootstrap interval over seeds), ``exp1s_board`` (Exp1S records in the paper's layout, beside the
+paper's values), ``text`` (the printout), ``markdown_page`` and ``html_page`` (``README.md`` and
+``index.html``).
 """
 
 import pathlib

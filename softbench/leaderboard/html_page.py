@@ -2,13 +2,15 @@
 
 Inline CSS and JavaScript, no external resource: per robot and task a table whose columns sort
 on a click, and a bar chart (inline SVG) per metric of the mean error with its bootstrap
-interval as a whisker; links to each record and its video. The page carries no time of its
-own, so the same records give the same bytes.
+interval as a whisker; links to each record and its video. Then the Exp1S records in the paper's
+layout, the paper's rows beside ours, and the forgetting matrix as a colour heat map. The page
+carries no time of its own, so the same records give the same bytes.
 """
 
 import html
 import pathlib
 
+from softbench.leaderboard import exp1s_board
 from softbench.leaderboard import links
 from softbench.leaderboard import ranking
 
@@ -18,6 +20,9 @@ _CHART_VALUE_WIDTH = 70  # (px) right of the bars, for the mean.
 _CHART_ROW_HEIGHT = 22  # (px) per bar.
 _CHART_BAR_HEIGHT = 14  # (px)
 _CHART_PAD = 6  # (px) above the first and below the last bar.
+_HEAT_LOW = (247, 251, 255)  # (RGB) Heat-map colour of 0 %.
+_HEAT_HIGH = (8, 48, 107)  # (RGB) Heat-map colour of the matrix's largest value.
+_HEAT_LIGHT_TEXT_FROM = 0.5  # Fraction of the largest value from which a cell's text is white.
 
 _STYLE = """
 body { font-family: system-ui, sans-serif; margin: 2rem auto; max-width: 72rem; padding: 0 1rem;
@@ -35,6 +40,12 @@ figure { margin: 0; } figcaption { font-size: 0.85rem; color: #57606a; }
 svg text { font-size: 11px; fill: #1b1f24; }
 svg .bar { fill: #4c78a8; } svg .whisker { stroke: #1b1f24; stroke-width: 1.2; }
 .note { color: #57606a; font-size: 0.9rem; }
+table.exp1s th { cursor: default; } table.exp1s caption { text-align: left; font-size: 0.85rem;
+  color: #57606a; caption-side: top; padding-bottom: 0.3rem; }
+tr.paper td { color: #57606a; font-style: italic; border-bottom-color: #8c959f; }
+table.heat td.figure { text-align: right; min-width: 4.5rem; }
+.legend { display: inline-block; width: 8rem; height: 0.7rem; vertical-align: middle;
+          border: 1px solid #d0d7de; }
 """
 
 _SCRIPT = """
@@ -152,6 +163,66 @@ def _group(group: ranking.Group, out: pathlib.Path) -> str:
   return "\n".join(parts)
 
 
+def _exp1s_table(table: exp1s_board.Table) -> str:
+  head = "".join(f'<th scope="col">{_e(name)}</th>' for name in table.header)
+  body = []
+  for index, row in enumerate(table.rows):
+    cells = "".join(f"<td>{_e(value)}</td>" if column < table.label_columns else
+                    f'<td class="figure">{_e(value)}</td>' for column, value in enumerate(row))
+    body.append(f'<tr class="paper">{cells}</tr>' if index in table.paper_rows else
+                f"<tr>{cells}</tr>")
+  return (f'<table class="exp1s"><caption>{_e(table.caption)}</caption><thead><tr>{head}</tr>'
+          f'</thead><tbody>{"".join(body)}</tbody></table>')
+
+
+def _rgb(colour: tuple[float, ...]) -> str:
+  return "#" + "".join(f"{round(channel):02x}" for channel in colour)
+
+
+def _heat_map(entry: exp1s_board.Entry) -> str:
+  """The forgetting matrix with each cell coloured by its value (light 0, dark the largest)."""
+  table = exp1s_board.forgetting_table(entry)
+  values = entry.forgetting()
+  highest = max(value for row in values for value in row if value is not None)
+  head = "".join(f'<th scope="col">{_e(name)}</th>' for name in table.header)
+  body = []
+  for row, texts in zip(values, table.rows):
+    cells = [f"<td>{_e(texts[0])}</td>"]
+    for value, text in zip(row, texts[1:]):
+      if value is None:
+        cells.append('<td class="empty"></td>')  # Not yet learned at this stage.
+        continue
+      share = value / highest if highest > 0 else 0.0
+      colour = _rgb(tuple(low + share * (high - low) for low, high in zip(_HEAT_LOW, _HEAT_HIGH)))
+      ink = "#ffffff" if share >= _HEAT_LIGHT_TEXT_FROM else "#1b1f24"
+      cells.append(f'<td class="figure" style="background:{colour};color:{ink}" '
+                   f'data-value="{value!r}">{_e(text)}</td>')
+    body.append(f"<tr>{''.join(cells)}</tr>")
+  legend = (f'<p class="note">Colour: 0 % <span class="legend" style="background:linear-gradient('
+            f'to right,{_rgb(_HEAT_LOW)},{_rgb(_HEAT_HIGH)})"></span> '
+            f"{_e(ranking.number(highest))} % (the largest value).</p>")
+  return (f'<table class="exp1s heat"><caption>{_e(table.caption)}</caption><thead><tr>{head}'
+          f'</tr></thead><tbody>{"".join(body)}</tbody></table>{legend}')
+
+
+def _exp1s_group(group: exp1s_board.Group, out: pathlib.Path) -> str:
+  parts = [f'<section id="{_e(group.anchor)}"><h2>{_e(group.title)}</h2>']
+  for entry in group.entries:
+    parts.append(f"<h3>{_e(entry.label)}</h3>")
+    parts.append(f"<p>{_e(exp1s_board.describe(entry))}; record "
+                 f'<a href="{_e(links.record(entry, out))}">{_e(entry.path.name)}</a>.</p>')
+    parts += [_exp1s_table(table) for table in exp1s_board.score_tables(entry)]
+    parts.append(_heat_map(entry))
+  if group.superseded:
+    items = "".join(f'<li><a href="{_e(links.record(entry, out))}">{_e(entry.path.name)}</a> '
+                    f"({_e(entry.label)}, {_e(entry.record['date'])})</li>"
+                    for entry in group.superseded)
+    parts.append('<p class="note">Superseded by a newer record of the same agent and profile:'
+                 f"</p><ul class=\"note\">{items}</ul>")
+  parts += [f'<p class="note">{_e(exp1s_board.about_paper())}</p>', "</section>"]
+  return "\n".join(parts)
+
+
 def render(board: ranking.Leaderboard, results: pathlib.Path, out: pathlib.Path) -> str:
   """The page, with links relative to the folder ``out`` it is written to."""
   results_link = links.relative(pathlib.Path(results), out)
@@ -167,8 +238,12 @@ def render(board: ranking.Leaderboard, results: pathlib.Path, out: pathlib.Path)
         f"{ranking.BOOTSTRAP_RESAMPLES:,} resamples] with {ranking.MIN_SEEDS_FOR_INTERVAL} or "
         "more seeds. How to submit an agent: the <em>Leaderboard</em> section of softbench's "
         "README.</p>")
+    if board.exp1s:
+      intro.append(f"<p>{_e(exp1s_board.explanation())}</p>")
     intro.append("<nav><ul>" + "".join(f'<li><a href="#{_e(group.anchor)}">{_e(group.title)}'
-                                        f"</a></li>" for group in board.groups) + "</ul></nav>")
+                                        f"</a></li>"
+                                        for group in (*board.groups, *board.exp1s)) +
+                  "</ul></nav>")
   else:
     intro.append("<p>No result records yet. Make one with <code>softbench run</code> (for "
                  "example <code>softbench run --task spiral --agent smpl</code>), then run "
@@ -179,4 +254,5 @@ def render(board: ranking.Leaderboard, results: pathlib.Path, out: pathlib.Path)
       "<title>softbench leaderboard</title>", f"<style>{_STYLE}</style>", "</head>", "<body>",
       "<h1>softbench leaderboard</h1>", *intro,
       *(_group(group, out) for group in board.groups),
+      *(_exp1s_group(group, out) for group in board.exp1s),
       f"<script>{_SCRIPT}</script>", "</body>", "</html>", ""])

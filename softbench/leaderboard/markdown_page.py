@@ -1,7 +1,9 @@
-"""The leaderboard as markdown (``leaderboard/README.md``): one table per robot and task."""
+"""The leaderboard as markdown (``leaderboard/README.md``): one table per robot and task, then
+the Exp1S records in the paper's layout."""
 
 import pathlib
 
+from softbench.leaderboard import exp1s_board
 from softbench.leaderboard import links
 from softbench.leaderboard import ranking
 
@@ -32,7 +34,9 @@ def _intro(board: ranking.Leaderboard, results_link: str) -> list[str]:
       f"percentile bootstrap confidence interval of the mean ({ranking.BOOTSTRAP_RESAMPLES:,} "
       f"resamples) in brackets when there are {ranking.MIN_SEEDS_FOR_INTERVAL} or more seeds. "
       "How to submit an agent: the *Leaderboard* section of softbench's README.", "",
-      "Tables: " + ", ".join(f"[{group.title}](#{group.anchor})" for group in board.groups), ""]
+      *([_escaped(exp1s_board.explanation()), ""] if board.exp1s else []),
+      "Tables: " + ", ".join(f"[{group.title}](#{group.anchor})"
+                             for group in (*board.groups, *board.exp1s)), ""]
 
 
 def _table(group: ranking.Group, out: pathlib.Path) -> list[str]:
@@ -57,10 +61,36 @@ def _table(group: ranking.Group, out: pathlib.Path) -> list[str]:
   return lines
 
 
+def _exp1s_table(table: exp1s_board.Table) -> list[str]:
+  return [f"*{_escaped(table.caption)}*", "",
+          "| " + " | ".join(map(_escaped, table.header)) + " |",
+          "|" + "|".join("---" if index < table.label_columns else "---:"
+                         for index in range(len(table.header))) + "|",
+          *("| " + " | ".join(map(_escaped, row)) + " |" for row in table.rows), ""]
+
+
+def _exp1s_group(group: exp1s_board.Group, out: pathlib.Path) -> list[str]:
+  lines = [f'<a id="{group.anchor}"></a>', "", f"## {group.title}", ""]
+  for entry in group.entries:
+    lines += [f"### {_escaped(entry.label)}", "",
+              f"{_escaped(exp1s_board.describe(entry))}; record "
+              f"{_link(entry.path.name, links.record(entry, out))}.", ""]
+    for table in exp1s_board.tables(entry):
+      lines += _exp1s_table(table)
+  if group.superseded:
+    lines += ["Superseded by a newer record of the same agent and profile: " +
+              "; ".join(f"{_link(entry.path.name, links.record(entry, out))} "
+                        f"({_escaped(entry.label)}, {entry.record['date']})"
+                        for entry in group.superseded), ""]
+  return lines + [_escaped(exp1s_board.about_paper()), ""]
+
+
 def render(board: ranking.Leaderboard, results: pathlib.Path, out: pathlib.Path) -> str:
   """The markdown page, with links relative to the folder ``out`` it is written to."""
   results_link = links.relative(pathlib.Path(results), out)
   lines = _intro(board, results_link)
   for group in board.groups:
     lines += _table(group, out)
+  for group in board.exp1s:
+    lines += _exp1s_group(group, out)
   return "\n".join(lines).rstrip("\n") + "\n"

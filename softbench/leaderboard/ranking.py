@@ -7,7 +7,8 @@ the mean over seeds of the episode's module-averaged position error. Every metri
 and standard deviation (ddof 0, as ``softbench run`` prints) over seeds of the per-seed means and
 a 95 % percentile bootstrap confidence interval of the mean (``scipy.stats.bootstrap``, the method
 rliable uses by default), with a fixed random generator so that the same records give the same
-numbers; with fewer than 2 seeds there is no interval.
+numbers; with fewer than 2 seeds there is no interval. Exp1S records are grouped apart
+(``exp1s_board``), in the paper's layout rather than a ranking.
 """
 
 import dataclasses
@@ -19,6 +20,7 @@ import re
 import numpy as np
 
 from softbench import suite
+from softbench.leaderboard import exp1s_board
 from softbench.leaderboard import records
 
 CONFIDENCE = 0.95
@@ -110,9 +112,10 @@ class Group:
 
 @dataclasses.dataclass(frozen=True)
 class Leaderboard:
-  groups: tuple[Group, ...]
-  record_count: int
+  groups: tuple[Group, ...]  # Of softbench run records.
+  record_count: int  # Of every kind.
   latest_date: str | None  # The newest record's date: the pages carry no time of their own.
+  exp1s: tuple[exp1s_board.Group, ...] = ()  # Of softbench run --protocol exp1s records.
 
 
 def _group_key(record: dict) -> tuple[str, str, str]:
@@ -135,12 +138,12 @@ def _newest_first(entry: Entry) -> tuple:
 
 
 def rank(loaded: list[tuple[pathlib.Path, dict]]) -> Leaderboard:
-  """The leaderboard of checked records (``records.read_folder``)."""
+  """The leaderboard of checked records (``records.read_folder``) of every kind."""
   by_group: dict[tuple[str, str, str], list[Entry]] = {}
   for path, record in loaded:
-    if not record["per_seed"]:  # Adaptive activation: its own report (softbench.adaptive).
-      continue
-    by_group.setdefault(_group_key(record), []).append(Entry.of(path, record))
+    # Adaptive activation records hold per-target results, no per-seed ones (softbench.adaptive).
+    if record["format"] == records.FORMAT and record["per_seed"]:
+      by_group.setdefault(_group_key(record), []).append(Entry.of(path, record))
   groups = []
   for key in sorted(by_group, key=lambda k: (_robot_order(k[0]), suite.TASKS.index(k[1]), k[2])):
     newest: dict[tuple[str, str, str], Entry] = {}
@@ -154,7 +157,8 @@ def rank(loaded: list[tuple[pathlib.Path, dict]]) -> Leaderboard:
                     key=lambda entry: (entry.estimates[RANKED_BY].mean, entry.setting))
     groups.append(Group(*key, tuple(ranked), tuple(superseded)))
   latest = max((record for _, record in loaded), key=_moment, default=None)
-  return Leaderboard(tuple(groups), len(loaded), None if latest is None else latest["date"])
+  return Leaderboard(tuple(groups), len(loaded), None if latest is None else latest["date"],
+                     exp1s_board.group(loaded))
 
 
 def _decimals(value: float) -> int:

@@ -1,11 +1,14 @@
 """Result records: their JSON Schema, their integrity hash, and checked writing and reading.
 
 A record is one ``softbench run`` (format ``softbench-result``, version 2): provenance, settings
-and per-seed errors. ``write`` seals a record with ``sha256``, the hash of the canonical JSON of
-everything else in it, and ``read`` refuses a file that is not valid JSON, does not match the
-schema (``schema()``, JSON Schema draft 2020-12), holds a non-finite number, no longer matches its
-hash (a hand-edited number), or contradicts itself (seed count, module counts, the mean over
-modules). Every refusal is one line that names the file.
+and per-seed errors; or one ``softbench run --protocol exp1s`` (format
+``softbench-exp1s-result``, version 2, schema and checks in ``exp1s_records``). Reading and
+writing dispatch on ``format``. ``write`` seals a record with ``sha256``, the hash of the
+canonical JSON of everything else in it, and ``read`` refuses a file that is not valid JSON, does
+not match its kind's schema (``schema()``, ``exp1s_records.schema()``, JSON Schema draft
+2020-12), holds a non-finite number, no longer matches its hash (a hand-edited number), or
+contradicts itself (seed count, module counts, the mean over modules). Every refusal is one line
+that names the file.
 
 Fields other than the known ones are allowed only as sections (JSON objects), which other
 commands add to their records (a fault, an adaptive schedule); the hash covers them too.
@@ -13,25 +16,27 @@ Version 1 records (before the hash) are refused: they cannot be checked.
 """
 
 import copy
-import datetime
+import dataclasses
 import hashlib
 import json
 import math
 import pathlib
+from collections.abc import Callable
 
 import jsonschema
 from jsonschema import exceptions as schema_exceptions
 
-from softbench import profiles
 from softbench import robots
 from softbench import storage
 from softbench import suite
 from softbench.agents import learned
+from softbench.leaderboard import exp1s_records
+from softbench.leaderboard import record_fields
 
 DEFAULT_FOLDER = pathlib.Path("leaderboard/results")  # Where softbench run writes records.
 FORMAT = "softbench-result"
 VERSION = 2
-INTEGRITY_FIELD = "sha256"
+INTEGRITY_FIELD = record_fields.INTEGRITY_FIELD
 METRICS = ("position_mm", "orientation_deg", "normalised_tip_percent")
 """Errors a record may hold per seed; position and normalised tip error always, orientation
 except for position-only tasks (reach)."""
@@ -46,14 +51,15 @@ class RecordError(ValueError):
 
 
 def schema() -> dict:
-  """The JSON Schema (draft 2020-12) of a result record, enums from the current registries."""
-  non_negative = {"type": "number", "minimum": 0}
+  """The JSON Schema (draft 2020-12) of a ``softbench run`` record, enums from the current
+  registries."""
+  non_negative = record_fields.non_negative()
   per_module = {"type": "array", "items": non_negative, "minItems": 1}
   metric = {"type": "object", "additionalProperties": False,
             "required": ["per_module", "per_module_std_over_steps", "mean"],
             "properties": {"per_module": per_module, "per_module_std_over_steps": per_module,
                            "mean": non_negative}}
-  section = {"type": "object"}
+  section = record_fields.section()
   seed = {
       "type": "object",
       "required": ["seed", "steps", "mean_reward", "position_mm", "normalised_tip_percent"],
@@ -66,25 +72,15 @@ def schema() -> dict:
   properties = {
       "format": {"const": FORMAT},
       "version": {"const": VERSION},
-      "softbench_version": {"type": "string", "minLength": 1},
-      "git_commit": {"type": ["string", "null"]},
-      "robot": {"type": "string", "pattern": r"^(tendon-[0-9]+|pneumatic-433)$"},
+      "robot": {"type": "string", "pattern": record_fields.ROBOT_PATTERN},
       "task": {"enum": list(suite.TASKS)},
-      "agent": {"type": "string", "pattern": r"^[a-z0-9][a-z0-9_.-]*$", "maxLength": 64},
-      "profile": {"enum": list(profiles.PROFILES)},
-      "profile_settings": {"type": "object", "required": ["name"],
-                           "properties": {"name": {"type": "string"}}},
       "eval_mode": {"enum": list(learned.ERROR_SOURCES)},
       "trajectory": {"type": ["string", "null"]},
-      "seeds": {"type": "integer", "minimum": 1},
       "scored_modules": {"type": "array", "items": {"type": "integer", "minimum": 1},
                          "minItems": 1, "uniqueItems": True},
-      "per_seed": {"type": "array", "items": seed},
-      "wall_time_s": non_negative,
-      "date": {"type": "string", "format": "date-time"},
-      "machine": {"type": "object"},
+      "per_seed": {"type": "array", "items": seed},  # Empty in adaptive activation records.
       "video": {"type": "string", "minLength": 1},
-      INTEGRITY_FIELD: {"type": "string", "pattern": "^[0-9a-f]{64}$"},
+      **record_fields.properties(),
   }
   return {
       "$schema": "https://json-schema.org/draft/2020-12/schema",
@@ -96,9 +92,26 @@ def schema() -> dict:
   }
 
 
+@dataclasses.dataclass(frozen=True)
+class Kind:
+  """One kind of record: the version this softbench reads, its schema and its own checks."""
+
+  format: str
+  version: int
+  schema: Callable[[], dict]
+  check: Callable[[dict, record_fields.Refuse], None]
+
+
+def kinds() -> dict[str, Kind]:
+  """Every kind of record, by format."""
+  return {FORMAT: Kind(FORMAT, VERSION, schema, _check_consistency),
+          exp1s_records.FORMAT: Kind(exp1s_records.FORMAT, exp1s_records.VERSION,
+                                     exp1s_records.schema, exp1s_records.check)}
+
+
 def sections(record: dict) -> tuple[str, ...]:
-  """The names of a record's extra sections (fields the schema does not name), sorted."""
-  return tuple(sorted(set(record) - set(schema()["properties"])))
+  """The names of a checked record's extra sections (fields its schema does not name), sorted."""
+  return tuple(sorted(set(record) - set(kinds()[record["format"]].schema()["properties"])))
 
 
 def content_sha256(record: dict) -> str:
@@ -179,24 +192,30 @@ def validate(record: object, source: str) -> None:
   """
   if not isinstance(record, dict):
     raise RecordError(f"{source}: not a result record (a JSON object is expected)")
-  if record.get("format") != FORMAT:
+  known = kinds()
+  kind = known.get(record.get("format"))
+  if kind is None:
     raise RecordError(f"{source}: not a result record (format {record.get('format')!r}, "
-                      f"expected {FORMAT!r})")
+                      f"expected one of {', '.join(map(repr, known))})")
   version = record.get("version")
-  if version != VERSION:
+  if version != kind.version:
     why = ("it has no integrity hash, so it cannot be checked; run it again"
-           if isinstance(version, int) and version < VERSION else
-           f"this softbench reads version {VERSION}")
+           if isinstance(version, int) and version < kind.version else
+           f"this softbench reads version {kind.version}")
     raise RecordError(f"{source}: record version {version!r} is not read: {why}")
   _check_finite(record, source)
   error = schema_exceptions.best_match(
-      jsonschema.Draft202012Validator(schema()).iter_errors(record))
+      jsonschema.Draft202012Validator(kind.schema()).iter_errors(record))
   if error is not None:
     raise RecordError(f"{source}: {_describe(error)}")
   if record[INTEGRITY_FIELD] != content_sha256(record):
     raise RecordError(f"{source}: content does not match its {INTEGRITY_FIELD} (edited after "
                       f"softbench run wrote it?); records must not be edited by hand")
-  _check_consistency(record, source)
+
+  def refuse(message: str) -> None:
+    raise RecordError(f"{source}: {message}")
+
+  kind.check(record, refuse)
 
 
 def _where(path) -> str:
@@ -227,21 +246,15 @@ def _check_finite(value: object, source: str, path: tuple = ()) -> None:
       _check_finite(item, source, path + (index,))
 
 
-def _check_consistency(record: dict, source: str) -> None:
-  """What the schema cannot say: counts that must agree, means that must follow."""
-  def refuse(message: str) -> None:
-    raise RecordError(f"{source}: {message}")
-
+def _check_consistency(record: dict, refuse: record_fields.Refuse) -> None:
+  """What the schema cannot say of a run record: counts that must agree, means that must
+  follow."""
+  adaptive = ADAPTIVE_SECTION in record
+  if adaptive and record["per_seed"]:
+    refuse(f"an {ADAPTIVE_SECTION} record holds its scores in that section; per_seed must be "
+           f"empty")
+  record_fields.check(record, refuse, seed_entries=0 if adaptive else None)
   per_seed = record["per_seed"]
-  if ADAPTIVE_SECTION in record:
-    if per_seed:
-      refuse(f"an {ADAPTIVE_SECTION} record holds its scores in that section; per_seed must be "
-             f"empty")
-  elif len(per_seed) != record["seeds"]:
-    refuse(f"seeds is {record['seeds']} but per_seed has {len(per_seed)} entries")
-  numbers = [entry["seed"] for entry in per_seed]
-  if len(set(numbers)) != len(numbers):
-    refuse(f"per_seed repeats a seed ({numbers})")
   try:
     num_modules = robots.make(record["robot"]).num_modules
   except ValueError as error:
@@ -249,17 +262,8 @@ def _check_consistency(record: dict, source: str) -> None:
   if max(record["scored_modules"]) > num_modules:
     refuse(f"scored_modules {record['scored_modules']} name a module beyond {record['robot']}'s "
            f"{num_modules}")
-  if record["profile_settings"]["name"] != record["profile"]:
-    refuse(f"profile_settings.name {record['profile_settings']['name']!r} is not the profile "
-           f"{record['profile']!r}")
   if (record["trajectory"] is None) == (record["task"] == "custom"):
     refuse("trajectory goes with task custom, and task custom needs one")
-  try:
-    date = datetime.datetime.fromisoformat(record["date"])
-  except ValueError:
-    refuse(f"date {record['date']!r} is not an ISO 8601 date and time")
-  if date.tzinfo is None:
-    refuse(f"date {record['date']!r} has no time zone")
   measured = [name for name in METRICS if per_seed and name in per_seed[0]]
   for index, entry in enumerate(per_seed):
     if [name for name in METRICS if name in entry] != measured:

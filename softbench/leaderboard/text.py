@@ -2,6 +2,7 @@
 
 import pathlib
 
+from softbench.leaderboard import exp1s_board
 from softbench.leaderboard import ranking
 from softbench.leaderboard import records
 
@@ -22,9 +23,15 @@ def summary(board: ranking.Leaderboard, results: pathlib.Path) -> str:
     option = "" if pathlib.Path(results) == records.DEFAULT_FOLDER else f" --results {results}"
     return (f"no result records in {results} ({where}); make one with softbench run, e.g. "
             f"softbench run --task spiral --agent smpl{option}")
-  return (f"{board.record_count} result record(s) in {results}, newest {board.latest_date}; "
-          f"one row per agent, profile and eval mode (its newest record), ranked by position "
-          f"error; mean ± std over seeds [{ranking.CONFIDENCE:.0%} bootstrap CI of the mean]")
+  parts = [f"{board.record_count} result record(s) in {results}, newest {board.latest_date}"]
+  if board.groups:
+    parts.append(f"one row per agent, profile and eval mode (its newest record), ranked by "
+                 f"position error; mean ± std over seeds [{ranking.CONFIDENCE:.0%} bootstrap CI "
+                 f"of the mean]")
+  if board.exp1s:
+    parts.append("Exp1S: the newest record per agent and profile, in the paper's layout, "
+                 "mean ± std over seeds")
+  return "; ".join(parts)
 
 
 def table(group: ranking.Group) -> str:
@@ -42,6 +49,27 @@ def table(group: ranking.Group) -> str:
   return "\n".join(lines)
 
 
+def exp1s_table(table: exp1s_board.Table) -> list[str]:
+  """One table of an Exp1S entry: its caption, then the aligned header and rows."""
+  rows = [list(table.header), *map(list, table.rows)]
+  right = set(range(table.label_columns, len(table.header)))
+  return [f"  {table.caption}", *("    " + line for line in _aligned(rows, right))]
+
+
+def exp1s_section(group: exp1s_board.Group) -> str:
+  """The title, every shown entry's tables, the superseded records and the paper's source."""
+  lines = [group.title]
+  for entry in group.entries:
+    lines.append(f"  {exp1s_board.describe(entry)}, {entry.path.name}")
+    for exp1s in exp1s_board.tables(entry):
+      lines += exp1s_table(exp1s)
+  for entry in group.superseded:
+    lines.append(f"  superseded: {entry.path.name} ({entry.label}, {entry.record['date']})")
+  lines.append(f"  {exp1s_board.about_paper()}")
+  return "\n".join(lines)
+
+
 def report(board: ranking.Leaderboard, results: pathlib.Path) -> str:
   """The whole printout."""
-  return "\n\n".join([summary(board, results), *(table(group) for group in board.groups)])
+  return "\n\n".join([summary(board, results), *(table(group) for group in board.groups),
+                       *(exp1s_section(group) for group in board.exp1s)])

@@ -11,7 +11,6 @@ import pathlib
 import platform
 import sys
 
-import numpy as np
 
 from softbench.robots import base
 from softbench.storage import write_atomically

@@ -1,0 +1,67 @@
+"""What every kind of result record shares: the JSON Schema of its provenance, agent, profile,
+seed and integrity fields, and the checks of those fields that a schema cannot make.
+
+``records`` (``softbench run``'s records) and ``exp1s_records`` (``softbench run --protocol
+exp1s``'s) build their schemas from these parts, so that the two kinds cannot drift apart.
+"""
+
+import datetime
+from collections.abc import Callable
+from typing import NoReturn
+
+from softbench import profiles
+
+INTEGRITY_FIELD = "sha256"
+AGENT_PATTERN = r"^[a-z0-9][a-z0-9_.-]*$"
+ROBOT_PATTERN = r"^(tendon-[0-9]+|pneumatic-433)$"
+
+Refuse = Callable[[str], NoReturn]
+"""Raises the record's error with a one-line message (the caller adds the file's name)."""
+
+
+def non_negative() -> dict:
+  return {"type": "number", "minimum": 0}
+
+
+def section() -> dict:
+  """An extra field: allowed only as a JSON object (a fault, an adaptive schedule, ...)."""
+  return {"type": "object"}
+
+
+def properties() -> dict:
+  """The schema of the fields every record has, by name."""
+  return {
+      "softbench_version": {"type": "string", "minLength": 1},
+      "git_commit": {"type": ["string", "null"]},
+      "agent": {"type": "string", "pattern": AGENT_PATTERN, "maxLength": 64},
+      "profile": {"enum": list(profiles.PROFILES)},
+      "profile_settings": {"type": "object", "required": ["name"],
+                           "properties": {"name": {"type": "string"}}},
+      "seeds": {"type": "integer", "minimum": 1},
+      "wall_time_s": non_negative(),
+      "date": {"type": "string", "format": "date-time"},
+      "machine": {"type": "object"},
+      INTEGRITY_FIELD: {"type": "string", "pattern": "^[0-9a-f]{64}$"},
+  }
+
+
+def check(record: dict, refuse: Refuse, seed_entries: int | None = None) -> None:
+  """One entry per seed (``seed_entries`` entries where given), no seed twice, the profile's
+  settings under its name, a dated record."""
+  per_seed = record["per_seed"]
+  if seed_entries is not None and len(per_seed) != seed_entries:
+    refuse(f"per_seed has {len(per_seed)} entries, {seed_entries} expected")
+  if seed_entries is None and len(per_seed) != record["seeds"]:
+    refuse(f"seeds is {record['seeds']} but per_seed has {len(per_seed)} entries")
+  numbers = [entry["seed"] for entry in per_seed]
+  if len(set(numbers)) != len(numbers):
+    refuse(f"per_seed repeats a seed ({numbers})")
+  if record["profile_settings"]["name"] != record["profile"]:
+    refuse(f"profile_settings.name {record['profile_settings']['name']!r} is not the profile "
+           f"{record['profile']!r}")
+  try:
+    date = datetime.datetime.fromisoformat(record["date"])
+  except ValueError:
+    refuse(f"date {record['date']!r} is not an ISO 8601 date and time")
+  if date.tzinfo is None:
+    refuse(f"date {record['date']!r} has no time zone")
