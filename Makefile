@@ -4,7 +4,7 @@ PYTHON ?= python3
 VENV := .venv
 STAMP := $(VENV)/.installed
 
-.PHONY: run test bench models
+.PHONY: run test bench models leaderboard
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -23,3 +23,19 @@ bench: $(STAMP)
 
 models: $(STAMP)
 	$(VENV)/bin/softbench models export --measure-speed
+
+# Every agent on every task of the leaderboard's robots, then the Exp1S protocol, then the pages.
+# PROFILE=paper (default) is the paper's budget: hours per agent on a laptop CPU. Every run reuses
+# cached datasets and checkpoints, so an interrupted fill resumes; the pages show the newest record
+# of each setting.
+PROFILE ?= paper
+LEADERBOARD_ROBOTS := tendon-3 pneumatic-433
+LEADERBOARD_TASKS := babbling circle rectangle spiral reach
+LEADERBOARD_AGENTS := smpl mlp lstm vae-lstm bilstm reference zero random
+leaderboard: $(STAMP)
+	set -e; for robot in $(LEADERBOARD_ROBOTS); do for task in $(LEADERBOARD_TASKS); do \
+	  for agent in $(LEADERBOARD_AGENTS); do \
+	    $(VENV)/bin/softbench run --robot $$robot --task $$task --agent $$agent --profile $(PROFILE); \
+	  done; done; done
+	$(VENV)/bin/softbench run --protocol exp1s --agent smpl --profile $(PROFILE)
+	$(VENV)/bin/softbench leaderboard --write
