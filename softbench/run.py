@@ -80,7 +80,8 @@ def settings(task: str, agent: str, robot: str | None = None, seeds: int | None 
                      None if trajectory is None else str(trajectory))
 
 
-def _task_options(run: RunSettings) -> dict:
+def task_options(run: RunSettings) -> dict:
+  """The options ``suite.load`` gets for ``run``'s task (episode length, trajectory)."""
   if run.task == "custom":
     return {"trajectory": run.trajectory}
   if run.profile.episode_length is None:
@@ -117,17 +118,24 @@ def _machine() -> dict:
           "torch": torch.__version__, "device": str(learned.training.default_device())}
 
 
-def _run_seed(run: RunSettings, seed: int, show_progress: bool) -> tuple[dict, tuple[int, ...]]:
-  """Builds (trains) the agent of ``seed``, runs one episode and scores it."""
+def seed_episode(run: RunSettings, seed: int, show_progress: bool = False) -> evaluation.Episode:
+  """Builds (trains) the agent of ``seed`` and runs it through one episode (environment seed
+  ``seed``)."""
   arm = robots.make(run.robot)
   agent = agents.make(run.agent, arm, seed, run.profile, show_progress)
   if isinstance(agent, learned.LearnedAgent):
     agent.error_source = run.eval_mode
-  env = suite.load(arm, run.task, seed=seed, **_task_options(run))
-  episode = evaluation.run_episode(env, agent, run.task, show_progress)
+  env = suite.load(arm, run.task, seed=seed, **task_options(run))
+  return evaluation.run_episode(env, agent, run.task, show_progress)
+
+
+def _run_seed(run: RunSettings, seed: int,
+              show_progress: bool) -> tuple[dict, evaluation.Episode]:
+  """The episode of ``seed`` and its scores."""
+  episode = seed_episode(run, seed, show_progress)
   return ({"seed": seed, "steps": len(episode.actions),
            "mean_reward": float(episode.rewards.mean()),
-           **_seed_scores(episode.score(arm.length))}, episode.scored_modules)
+           **_seed_scores(episode.score(robots.make(run.robot).length))}, episode)
 
 
 def _ignore_interrupts() -> None:
@@ -135,7 +143,7 @@ def _ignore_interrupts() -> None:
   signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
-def _parallel_seeds(run: RunSettings, workers: int) -> list[tuple[dict, tuple[int, ...]]]:
+def _parallel_seeds(run: RunSettings, workers: int) -> list[tuple[dict, evaluation.Episode]]:
   """Seeds in ``workers`` processes (one torch and MuJoCo thread each), with one progress bar.
 
   On Ctrl-C the workers are terminated; seeds whose checkpoints were written are reused by the
@@ -165,6 +173,12 @@ def execute(run: RunSettings, show_progress: bool = True, workers: int | None = 
 
   The babbling dataset is collected first (on every core), so that the seeds share it.
   """
+  return execute_episodes(run, show_progress, workers)[0]
+
+
+def execute_episodes(run: RunSettings, show_progress: bool = True, workers: int | None = None
+                     ) -> tuple[dict, list[evaluation.Episode]]:
+  """``execute``, also returning every seed's episode (in seed order) for plots and videos."""
   started = time.perf_counter()
   if agents.describe(run.agent).learned:
     data.collect(run.robot, samples=run.profile.samples, seed=learned.DATA_SEED,
@@ -174,17 +188,19 @@ def execute(run: RunSettings, show_progress: bool = True, workers: int | None = 
     outcomes = _parallel_seeds(run, workers)
   else:
     outcomes = [_run_seed(run, seed, show_progress) for seed in range(run.seeds)]
-  return {
+  record = {
       "format": RECORD_FORMAT, "version": RECORD_VERSION,
       "softbench_version": softbench.__version__, "git_commit": _git_commit(),
       "robot": run.robot, "task": run.task, "agent": run.agent, "profile": run.profile.name,
       "profile_settings": dataclasses.asdict(run.profile), "eval_mode": run.eval_mode,
       "trajectory": run.trajectory, "seeds": run.seeds,
-      "scored_modules": list(outcomes[0][1]), "per_seed": [entry for entry, _ in outcomes],
+      "scored_modules": list(outcomes[0][1].scored_modules),
+      "per_seed": [entry for entry, _ in outcomes],
       "wall_time_s": round(time.perf_counter() - started, 3),
       "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
       "machine": _machine(),
   }
+  return record, [episode for _, episode in outcomes]
 
 
 def summary(record: dict, metric: str) -> tuple[list[metrics.Statistic], metrics.Statistic]:
