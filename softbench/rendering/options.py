@@ -11,9 +11,10 @@ DEFAULT_WIDTH = 640  # (pixels)
 DEFAULT_HEIGHT = 480  # (pixels)
 DEFAULT_FPS = 30.0  # (frames/s)
 MIN_SIZE = 16  # (pixels) Smallest width or height.
-MAX_SIZE = 4096  # (pixels) Largest width or height (the off-screen buffer is made this large).
+MAX_SIZE = 4096  # (pixels) Largest width or height (the off-screen buffer grows to the request).
 MAX_FPS = 240.0  # (frames/s)
-MAX_FRAMES_PER_STEP = 100  # Frames within one control period; each period is >= 200 physics steps.
+MAX_FRAMES_PER_STEP = 100  # Frames within one control period (benchmark robots: 200 or more
+# physics steps per period; the replay refuses more frames than steps).
 CAMERAS = ("workspace", "front", "side", "below")
 """Named cameras of every rendered scene, each framing the whole episode: ``workspace`` an
 oblique view from above, ``front`` along world +y, ``side`` along world -x, ``below`` straight
