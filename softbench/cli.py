@@ -10,11 +10,16 @@ from softbench import agents
 from softbench import continual
 from softbench import data
 from softbench import leaderboard
+from softbench import plots
 from softbench import profiles
 from softbench import robots
 from softbench import run as run_module
 from softbench import suite
 from softbench.adaptive import plot as adaptive_plot
+from softbench.data import seeding
+from softbench.rendering import options as video_options
+from softbench.rendering import replay as episode_replay
+from softbench.rendering import video
 from softbench.robots import export as model_export
 
 EXIT_USAGE = 2
@@ -91,7 +96,10 @@ def _run_protocol(args: argparse.Namespace) -> None:
     raise ValueError(f"--protocol {args.protocol} trains SMPL's columns in sequence; it takes "
                      f"--agent smpl, got {args.agent!r}")
   given = [flag for flag, value in (("--task", args.task), ("--robot", args.robot),
-                                    ("--trajectory", args.trajectory)) if value is not None]
+                                    ("--trajectory", args.trajectory), ("--video", args.video),
+                                    ("--module", args.module), ("--targets", args.targets),
+                                    ("--helpers", args.helpers)) if value is not None]
+  given += ["--adaptive"] if args.adaptive else []
   if given or args.eval != "physics":
     raise ValueError(f"--protocol {args.protocol} fixes its robots, tasks and loops; drop "
                      f"{', '.join(given) or '--eval'}")
@@ -100,8 +108,35 @@ def _run_protocol(args: argparse.Namespace) -> None:
   path = continual.record_path(record, pathlib.Path(args.results))
   run_module.write_record(record, path)
   print(f"result record: {path}")
+  heat_map = plots.forgetting_matrix(continual.mean_forgetting(record), record["robots"],
+                                     path.with_name(f"{path.stem}-forgetting.png"))
+  print(f"plot: {heat_map}")
   if args.json:
     run_module.write_record(record, pathlib.Path(args.json))
+
+
+def _number(name: str, text: str, kind: type) -> int | float:
+  try:
+    return kind(text)
+  except ValueError:
+    raise ValueError(f"{name} must be a number, got {text!r}") from None
+
+
+def _video_options(args: argparse.Namespace) -> video_options.VideoOptions:
+  return video_options.VideoOptions(
+      _number("width", args.width, int), _number("height", args.height, int),
+      _number("fps", args.fps, float), args.camera,
+      _number("frames per step", args.frames_per_step, int))
+
+
+def _write_video(settings: run_module.RunSettings, seed: int, episode, path: pathlib.Path,
+                 options: video_options.VideoOptions) -> None:
+  stats = video.render(episode_replay.of_run(settings, seed, episode), path, options,
+                       show_progress=True)
+  print(f"video: {stats.path} ({stats.frames} frames, {options.width}x{options.height} at "
+        f"{options.fps:g} fps, {stats.frames / options.fps:.1f} s, "
+        f"{stats.size_bytes / 1024:.0f} KiB); rendered with {stats.backend} in "
+        f"{stats.render_seconds:.1f} s ({stats.frames_per_second:.1f} frames/s)")
 
 
 def _run(args: argparse.Namespace) -> None:
@@ -112,7 +147,12 @@ def _run(args: argparse.Namespace) -> None:
   settings = run_module.settings(args.task, args.agent, args.robot, args.seeds, args.profile,
                                  args.eval, args.trajectory, args.module, args.adaptive,
                                  args.targets, args.helpers)
-  record = run_module.execute(settings)
+  if args.video and settings.adaptive:
+    raise ValueError("--video renders one seed's episode; --adaptive draws its own figure")
+  if args.video:
+    options = _video_options(args)
+    video_path = video_options.check_video_path(args.video)
+  record, episodes = run_module.execute_episodes(settings)
   print(run_module.table(record))
   path = run_module.record_path(record, pathlib.Path(args.results))
   run_module.write_record(record, path)
@@ -121,6 +161,37 @@ def _run(args: argparse.Namespace) -> None:
     print(f"plot: {adaptive_plot.write(record, path.with_suffix('.png'))}")
   if args.json:
     run_module.write_record(record, pathlib.Path(args.json))
+  for plot in plots.save_run_plots(path, record, episodes) if episodes else ():
+    print(f"plot: {plot}")
+  if args.video:
+    _write_video(settings, 0, episodes[0], video_path, options)
+
+
+def _render(args: argparse.Namespace) -> None:
+  options = _video_options(args)
+  path = video_options.check_video_path(args.out)
+  seed = _number("seed", args.seed, int)
+  seeding.check_seed(seed)
+  settings = run_module.settings(args.task, args.agent, args.robot, 1, args.profile, args.eval,
+                                 args.trajectory)
+  episode = run_module.seed_episode(settings, seed, show_progress=True)
+  _write_video(settings, seed, episode, path, options)
+
+
+def _add_video_arguments(parser: argparse.ArgumentParser) -> None:
+  parser.add_argument("--width", default=str(video_options.DEFAULT_WIDTH),
+                      help=f"frame width in pixels, even (default {video_options.DEFAULT_WIDTH})")
+  parser.add_argument("--height", default=str(video_options.DEFAULT_HEIGHT),
+                      help=f"frame height in pixels, even (default "
+                           f"{video_options.DEFAULT_HEIGHT})")
+  parser.add_argument("--fps", default=f"{video_options.DEFAULT_FPS:g}",
+                      help=f"frames per second (default {video_options.DEFAULT_FPS:g})")
+  parser.add_argument("--camera", default=video_options.DEFAULT_CAMERA,
+                      help=f"one of {', '.join(video_options.CAMERAS)} (default "
+                           f"{video_options.DEFAULT_CAMERA})")
+  parser.add_argument("--frames-per-step", default="1",
+                      help="frames per control step, to show the motion within each step "
+                           "(default 1: the pose at the end of every step)")
 
 
 def _leaderboard(args: argparse.Namespace) -> None:
@@ -186,6 +257,8 @@ def build_parser() -> argparse.ArgumentParser:
   run_parser.add_argument("--results", default="leaderboard/results",
                           help="folder of the result records (default leaderboard/results)")
   run_parser.add_argument("--json", help="also write the result record to this file")
+  run_parser.add_argument("--video", help="also render seed 0's episode to this .mp4 file")
+  _add_video_arguments(run_parser)
   run_parser.set_defaults(run=_run)
   board_parser = commands.add_parser(
       "leaderboard", help="rank the result records per robot and task",
@@ -200,6 +273,24 @@ def build_parser() -> argparse.ArgumentParser:
   board_parser.add_argument("--out", default=str(leaderboard.DEFAULT_OUT),
                             help=f"folder of the pages (default {leaderboard.DEFAULT_OUT})")
   board_parser.set_defaults(run=_leaderboard)
+  render_parser = commands.add_parser(
+      "render", help="render an agent's episode of a task to an MP4 video",
+      description="Trains (or reuses) the agent for one seed, runs its episode and renders it "
+                  "off-screen (MUJOCO_GL=egl, else osmesa) with the target trail and the "
+                  "achieved tip path.")
+  render_parser.add_argument("--task", required=True, help=f"one of {', '.join(suite.TASKS)}")
+  render_parser.add_argument("--agent", required=True, help=f"one of {', '.join(agents.AGENTS)}")
+  render_parser.add_argument("--robot", help="default: the task's robot in the paper")
+  render_parser.add_argument("--out", required=True, help="the video file (.mp4)")
+  render_parser.add_argument("--seed", default="0", help="agent and environment seed (default 0)")
+  render_parser.add_argument("--profile", default=profiles.DEFAULT_PROFILE,
+                             help=f"one of {', '.join(profiles.PROFILES)} "
+                                  f"(default {profiles.DEFAULT_PROFILE})")
+  render_parser.add_argument("--eval", default="physics", help="physics (default), model or "
+                                                               "open-loop: the error fed back")
+  render_parser.add_argument("--trajectory", help="target poses for --task custom (.npy or .csv)")
+  _add_video_arguments(render_parser)
+  render_parser.set_defaults(run=_render)
   models = commands.add_parser("models", help="exported MJCF models")
   models_commands = models.add_subparsers(dest="models_command", required=True)
   export_parser = models_commands.add_parser("export", help="write models/<name>/ for every robot")
@@ -214,7 +305,7 @@ def main(argv: list[str] | None = None) -> int:
   args = build_parser().parse_args(argv)
   try:
     args.run(args)
-  except (ValueError, FileNotFoundError, FloatingPointError) as error:
+  except (ValueError, FileNotFoundError, FloatingPointError, video.RenderingUnavailable) as error:
     print(f"softbench: error: {error}", file=sys.stderr)
     return EXIT_USAGE
   except run_module.WorkerDied as error:

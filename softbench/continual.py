@@ -208,6 +208,14 @@ def execute(profile: profiles.Profile, seeds: int | None = None, show_progress: 
           "wall_time_s": round(time.perf_counter() - started, 3)}
 
 
+def mean_forgetting(record: dict) -> np.ndarray:
+  """The physics forgetting matrix (stages x configurations, normalised tip error in %), mean
+  over seeds; NaN for configurations not yet seen."""
+  matrices = [[[np.nan if value is None else value for value in row]
+               for row in seed["forgetting_tip_percent"]] for seed in record["per_seed"]]
+  return np.mean(np.array(matrices, dtype=float), axis=0)
+
+
 def _statistic(values: list[float]) -> str:
   statistic = metrics.Statistic.of(values)
   return f"{statistic.mean:.2f} ± {statistic.std:.2f}"

@@ -119,7 +119,8 @@ def _check_adaptive(task: str, agent: str, robot: str, seeds: int | None, module
     adaptive_activation.experiment.check_helpers(helpers)
 
 
-def _task_options(run: RunSettings) -> dict:
+def task_options(run: RunSettings) -> dict:
+  """The options ``suite.load`` gets for ``run``'s task (episode length, trajectory)."""
   if run.task == "custom":
     return {"trajectory": run.trajectory}
   options = {} if run.module is None else {"module": run.module}
@@ -157,17 +158,24 @@ def _machine() -> dict:
           "torch": torch.__version__, "device": str(learned.training.default_device())}
 
 
-def _run_seed(seed: int, run: RunSettings, show_progress: bool) -> tuple[dict, tuple[int, ...]]:
-  """Builds (trains) the agent of ``seed``, runs one episode and scores it."""
+def seed_episode(run: RunSettings, seed: int, show_progress: bool = False) -> evaluation.Episode:
+  """Builds (trains) the agent of ``seed`` and runs it through one episode (environment seed
+  ``seed``)."""
   arm = robots.make(run.robot)
   agent = agents.make(run.agent, arm, seed, run.profile, show_progress)
   if isinstance(agent, learned.LearnedAgent):
     agent.error_source = run.eval_mode
-  env = suite.load(arm, run.task, seed=seed, **_task_options(run))
-  episode = evaluation.run_episode(env, agent, run.task, show_progress)
+  env = suite.load(arm, run.task, seed=seed, **task_options(run))
+  return evaluation.run_episode(env, agent, run.task, show_progress)
+
+
+def _run_seed(seed: int, run: RunSettings,
+              show_progress: bool) -> tuple[dict, evaluation.Episode]:
+  """The episode of ``seed`` and its scores."""
+  episode = seed_episode(run, seed, show_progress)
   return ({"seed": seed, "steps": len(episode.actions),
            "mean_reward": float(episode.rewards.mean()),
-           **_seed_scores(episode.score(arm.length))}, episode.scored_modules)
+           **_seed_scores(episode.score(robots.make(run.robot).length))}, episode)
 
 
 def _ignore_interrupts() -> None:
@@ -235,6 +243,13 @@ def execute(run: RunSettings, show_progress: bool = True, workers: int | None = 
 
   The babbling dataset is collected first (on every core), so that the seeds share it.
   """
+  return execute_episodes(run, show_progress, workers)[0]
+
+
+def execute_episodes(run: RunSettings, show_progress: bool = True, workers: int | None = None
+                     ) -> tuple[dict, list[evaluation.Episode]]:
+  """``execute``, also returning every seed's episode (in seed order) for plots and videos;
+  none for an adaptive run (``softbench.adaptive`` draws its own figure)."""
   started, origin = time.perf_counter(), provenance()
   if agents.describe(run.agent).learned:
     data.collect(run.robot, samples=run.profile.samples, seed=learned.DATA_SEED,
@@ -247,15 +262,16 @@ def execute(run: RunSettings, show_progress: bool = True, workers: int | None = 
   else:
     outcomes = over_seeds(_run_seed, run.seeds, (run,), f"{run.agent} on {run.task}",
                           show_progress, workers)
-    results = {"scored_modules": list(outcomes[0][1]),
+    results = {"scored_modules": list(outcomes[0][1].scored_modules),
                "per_seed": [entry for entry, _ in outcomes]}
-  return {
+  record = {
       "format": RECORD_FORMAT, "version": RECORD_VERSION, **origin,
       "robot": run.robot, "task": run.task, "agent": run.agent, "profile": run.profile.name,
       "profile_settings": dataclasses.asdict(run.profile), "eval_mode": run.eval_mode,
       "trajectory": run.trajectory, "seeds": run.seeds, **results,
       "wall_time_s": round(time.perf_counter() - started, 3),
   }
+  return record, [] if run.adaptive else [episode for _, episode in outcomes]
 
 
 def summary(record: dict, metric: str) -> tuple[list[metrics.Statistic], metrics.Statistic]:

@@ -32,6 +32,7 @@ def test_exp1s_end_to_end(two_stages, tmp_path, capsys):
                   "closed loop, normalised tip error (%)", "forgetting matrix"):
     assert heading in out
   (path,) = results.glob("smpl-exp1s-tiny-*.json")
+  assert path.with_name(f"{path.stem}-forgetting.png").stat().st_size > 0
   record = records.read(path)  # Checked: schema, integrity hash, consistency.
   assert record == json.loads(path.read_text()) and record["version"] == continual.RECORD_VERSION
   assert record["robots"] == list(STAGES) and record["seeds"] == 1
