@@ -2,6 +2,7 @@
 one line on stderr and exit code 2."""
 
 import argparse
+import os
 import pathlib
 import sys
 
@@ -314,6 +315,9 @@ def main(argv: list[str] | None = None) -> int:
   except KeyboardInterrupt:
     print("softbench: interrupted; run the same command again to resume", file=sys.stderr)
     return EXIT_INTERRUPTED
+  except BrokenPipeError:  # The reader went away (softbench leaderboard | head).
+    os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    return EXIT_FAILURE
   return 0
 
 

@@ -1,7 +1,10 @@
 """The committed models regenerate byte for byte; the CLI lists robots and refuses bad input."""
 
 import json
+import os
 import pathlib
+import subprocess
+import sys
 
 import mujoco
 import pytest
@@ -103,3 +106,20 @@ def test_cli_collect_refuses_bad_input(argv, capsys, tmp_path, monkeypatch):
   lines = capsys.readouterr().err.strip().splitlines()
   assert len(lines) == 1 and lines[0].startswith("softbench: error: ")
   assert not (tmp_path / "datasets").exists()
+
+
+@pytest.mark.parametrize("backend", ["bogus"])
+def test_an_opengl_backend_mujoco_cannot_load_is_one_line(backend):
+  environment = {**os.environ, "MUJOCO_GL": backend}
+  result = subprocess.run([sys.executable, "-m", "softbench.launcher", "robots"], env=environment,
+                          capture_output=True, text=True, timeout=120)
+  assert result.returncode == cli.EXIT_USAGE
+  assert result.stderr.count("\n") == 1 and f"MUJOCO_GL='{backend}'" in result.stderr
+
+
+def test_a_closed_pipe_is_not_a_traceback(monkeypatch):
+  read_end, write_end = os.pipe()
+  os.close(read_end)  # The reader went away, as `softbench robots | head -1` does.
+  with os.fdopen(write_end, "w", buffering=1) as closed:
+    monkeypatch.setattr(sys, "stdout", closed)
+    assert cli.main(["robots"]) == cli.EXIT_FAILURE
