@@ -4,6 +4,9 @@ For each seed the agent is built (learned agents train on the robot's babbling d
 cached), then acts on one episode of the task (environment seed = the same seed); the episode's
 errors per module are averaged over its steps, and the table gives their mean and standard
 deviation over seeds. Every run writes a result record with full provenance.
+
+With ``faults`` (``--fault MODULE:ACTUATOR:GAIN``, ``softbench.robots.faults``) the agent is
+built for the healthy robot, as a deployed controller would be, and evaluated on the faulty one.
 """
 
 import dataclasses
@@ -32,6 +35,7 @@ from softbench import storage
 from softbench import suite
 from softbench.agents import learned
 from softbench.data import dataset
+from softbench.robots import faults as fault_model
 
 PAPER_ROBOT = {"babbling": "tendon-3", "circle": "tendon-3", "rectangle": "tendon-3",
                "spiral": "tendon-3", "custom": "tendon-3", "reach": "pneumatic-433"}
@@ -53,22 +57,25 @@ class RunSettings:
   profile: profiles.Profile
   eval_mode: str
   trajectory: str | None = None
+  faults: tuple[fault_model.Fault, ...] = ()
 
 
 def settings(task: str, agent: str, robot: str | None = None, seeds: int | None = None,
              profile: str = profiles.DEFAULT_PROFILE, eval_mode: str = "physics",
-             trajectory: str | None = None) -> RunSettings:
-  """Checked settings, with the defaults filled in.
+             trajectory: str | None = None, faults: tuple[str, ...] = ()) -> RunSettings:
+  """Checked settings, with the defaults filled in; ``faults`` as ``MODULE:ACTUATOR:GAIN`` text.
 
   Raises:
     ValueError: unknown task, agent, robot, profile or eval mode, seeds < 1, a trajectory
-      without the custom task or the custom task without one (one line).
+      without the custom task or the custom task without one, a malformed fault or one that
+      names no actuator of the robot (one line).
   """
   suite.describe(task)
   agents.describe(agent)
   chosen = profiles.get(profile)
   robot = robot or PAPER_ROBOT[task]
-  robots.make(robot)
+  parsed_faults = tuple(fault_model.parse(text) for text in faults)
+  robots.make(robot).with_faults(parsed_faults)
   seeds = chosen.seeds if seeds is None else seeds
   dataset.check_count("seeds", seeds)
   if eval_mode not in learned.ERROR_SOURCES:
@@ -77,7 +84,7 @@ def settings(task: str, agent: str, robot: str | None = None, seeds: int | None 
   if (trajectory is None) == (task == "custom"):
     raise ValueError("--trajectory goes with --task custom, and --task custom needs one")
   return RunSettings(task, agent, robot, seeds, chosen, eval_mode,
-                     None if trajectory is None else str(trajectory))
+                     None if trajectory is None else str(trajectory), parsed_faults)
 
 
 def _task_options(run: RunSettings) -> dict:
@@ -117,10 +124,10 @@ def _machine() -> dict:
           "torch": torch.__version__, "device": str(learned.training.default_device())}
 
 
-def _run_seed(run: RunSettings, seed: int, show_progress: bool) -> tuple[dict, tuple[int, ...]]:
-  """Builds (trains) the agent of ``seed``, runs one episode and scores it."""
-  arm = robots.make(run.robot)
-  agent = agents.make(run.agent, arm, seed, run.profile, show_progress)
+def evaluate(agent: agents.Agent, arm: robots.SoftArm, run: RunSettings, seed: int,
+             show_progress: bool = False) -> tuple[dict, tuple[int, ...]]:
+  """One episode of ``run``'s task (environment seed ``seed``) on ``arm``, faults included,
+  scored: the seed's record entry and the scored modules."""
   if isinstance(agent, learned.LearnedAgent):
     agent.error_source = run.eval_mode
   env = suite.load(arm, run.task, seed=seed, **_task_options(run))
@@ -128,6 +135,14 @@ def _run_seed(run: RunSettings, seed: int, show_progress: bool) -> tuple[dict, t
   return ({"seed": seed, "steps": len(episode.actions),
            "mean_reward": float(episode.rewards.mean()),
            **_seed_scores(episode.score(arm.length))}, episode.scored_modules)
+
+
+def _run_seed(run: RunSettings, seed: int, show_progress: bool) -> tuple[dict, tuple[int, ...]]:
+  """Builds (trains) the agent of ``seed`` for the healthy robot, runs one episode on the robot
+  with ``run.faults`` and scores it."""
+  arm = robots.make(run.robot)
+  agent = agents.make(run.agent, arm, seed, run.profile, show_progress)
+  return evaluate(agent, arm.with_faults(run.faults), run, seed, show_progress)
 
 
 def _ignore_interrupts() -> None:
@@ -166,6 +181,7 @@ def execute(run: RunSettings, show_progress: bool = True, workers: int | None = 
   The babbling dataset is collected first (on every core), so that the seeds share it.
   """
   started = time.perf_counter()
+  arm = robots.make(run.robot)
   if agents.describe(run.agent).learned:
     data.collect(run.robot, samples=run.profile.samples, seed=learned.DATA_SEED,
                  progress=show_progress)
@@ -180,6 +196,7 @@ def execute(run: RunSettings, show_progress: bool = True, workers: int | None = 
       "robot": run.robot, "task": run.task, "agent": run.agent, "profile": run.profile.name,
       "profile_settings": dataclasses.asdict(run.profile), "eval_mode": run.eval_mode,
       "trajectory": run.trajectory, "seeds": run.seeds,
+      "faults": [fault_model.describe(arm, fault) for fault in run.faults],
       "scored_modules": list(outcomes[0][1]), "per_seed": [entry for entry, _ in outcomes],
       "wall_time_s": round(time.perf_counter() - started, 3),
       "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
@@ -201,7 +218,9 @@ def table(record: dict) -> str:
   columns = {name: summary(record, name) for name, _ in measured}
   rows = [f"module {module}" for module in record["scored_modules"]] + ["mean"]
   header = f"{'':<10}" + "".join(f"{label:>22}" for _, label in measured)
-  lines = [f"{record['agent']} on {record['task']} ({record['robot']}), profile "
+  faulty = record.get("faults") or []
+  under = f" under fault {', '.join(fault['text'] for fault in faulty)}" if faulty else ""
+  lines = [f"{record['agent']} on {record['task']} ({record['robot']}{under}), profile "
            f"{record['profile']}, eval {record['eval_mode']}, {record['seeds']} seed(s): "
            f"mean ± std over seeds", header]
   for index, row in enumerate(rows):
@@ -217,8 +236,10 @@ def table(record: dict) -> str:
 
 def record_path(record: dict, results: pathlib.Path) -> pathlib.Path:
   stamp = record["date"].replace(":", "").replace("+0000", "Z")
-  return results / (f"{record['agent']}-{record['robot']}-{record['task']}-{record['profile']}-"
-                    f"{record['eval_mode']}-{stamp}.json")
+  faulty = "".join(f"-fault{fault['module']}.{fault['actuator']}.{fault['gain']:g}"
+                   for fault in record.get("faults") or [])
+  return results / (f"{record['agent']}-{record['robot']}{faulty}-{record['task']}-"
+                    f"{record['profile']}-{record['eval_mode']}-{stamp}.json")
 
 
 def write_record(record: dict, path: pathlib.Path) -> None:

@@ -20,6 +20,7 @@ orientation, as in the paper's reaching experiment.
 import contextlib
 import dataclasses
 import hashlib
+import pathlib
 from typing import Callable
 
 import numpy as np
@@ -166,7 +167,7 @@ class LearnedAgent(base.Agent):
                                        as_tensor(previous_action))
 
 
-def _training_configs(seed: int, profile: profiles.Profile
+def training_configs(seed: int, profile: profiles.Profile
                       ) -> tuple[training.ForwardTrainingConfig, training.InverseTrainingConfig]:
   common = dict(max_epochs=profile.max_epochs, patience=profile.patience, seed=seed,
                 compile=profile.compile)
@@ -202,7 +203,7 @@ def _train(name: str, robot: robot_base.SoftArm, views: list[data.View], seed: i
            ) -> tuple[InverseModel, list[smpl_forward.ForwardModel], list[data.Normalisation]]:
   """Collects or finds the dataset, then trains forward and inverse models (module docstring)."""
   dataset = data.collect(robot, samples=profile.samples, seed=DATA_SEED, progress=show)
-  forward_config, inverse_config = _training_configs(seed, profile)
+  forward_config, inverse_config = training_configs(seed, profile)
   device = training.default_device()
   with training.seeded(seed, torch.device("cpu")):
     inverse = _inverse_model(views, per_module, make_model)
@@ -230,16 +231,35 @@ def _train(name: str, robot: robot_base.SoftArm, views: list[data.View], seed: i
   return inverse, forwards, normalisations
 
 
+def _views(robot: robot_base.SoftArm, per_module: bool) -> list[data.View]:
+  return ([data.View.module(robot, k) for k in range(1, robot.num_modules + 1)] if per_module
+          else [data.View.whole_arm(robot)])
+
+
+def _trained_config(name: str, robot: robot_base.SoftArm, views: list[data.View], seed: int,
+                    profile: profiles.Profile) -> TrainedConfig:
+  return TrainedConfig(name, robot.name, hashlib.sha256(robot.to_xml().encode()).hexdigest(),
+                       tuple(view.name for view in views), profile.samples, seed,
+                       profile.max_epochs, profile.patience, profile.compile)
+
+
+def checkpoint_path(name: str, robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
+                    per_module: bool) -> pathlib.Path:
+  """Where ``build_agent`` caches the agent's checkpoint (it exists once trained)."""
+  return checkpoint_file(_trained_config(name, robot, _views(robot, per_module), seed, profile))
+
+
+def checkpoint_file(config) -> pathlib.Path:
+  return storage.softbench_home() / CHECKPOINT_FOLDER / f"{config.key}.pt"
+
+
 def build_agent(name: str, robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
                 per_module: bool, make_model: ModelFactory | None = None,
                 show_progress: bool = False) -> LearnedAgent:
   """A trained learned agent: from the checkpoint cache, or trained now and then cached."""
-  views = ([data.View.module(robot, k) for k in range(1, robot.num_modules + 1)] if per_module
-           else [data.View.whole_arm(robot)])
-  config = TrainedConfig(name, robot.name, hashlib.sha256(robot.to_xml().encode()).hexdigest(),
-                         tuple(view.name for view in views), profile.samples, seed,
-                         profile.max_epochs, profile.patience, profile.compile)
-  path = storage.softbench_home() / CHECKPOINT_FOLDER / f"{config.key}.pt"
+  views = _views(robot, per_module)
+  config = _trained_config(name, robot, views, seed, profile)
+  path = checkpoint_file(config)
   if path.exists():
     inverse = _inverse_model(views, per_module, make_model)
     forwards = [smpl_forward.ForwardModel(view.preceding_action_size + view.action_size,
