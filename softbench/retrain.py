@@ -100,7 +100,7 @@ def _seed(settings: RetrainSettings, seed: int, show_progress: bool) -> dict:
   smpl = agents.make(RETRAINED_AGENT, healthy, seed, run.profile, show_progress)
   before, scored = run_module.evaluate(smpl, healthy, run, seed, show_progress)
   under, _ = run_module.evaluate(smpl, faulty, run, seed, show_progress)
-  retrained = adaptation.retrain_column(smpl, faulty, seed, run.profile, show_progress)
+  retrained = adaptation.retrain_column(smpl, faulty, run.profile, show_progress)
   identical = adaptation.columns_bit_identical(smpl.inverse, retrained.agent.inverse,
                                                retrained.column)
   after, _ = run_module.evaluate(retrained.agent, faulty, run, seed, show_progress)

@@ -61,9 +61,10 @@ def test_a_fault_scales_exactly_its_actuator_and_nothing_else(name):
     action[int(entry)] = 0.8 if at_plus_one != 0 else -0.8
   qpos, qvel = _bent_state(healthy_model, healthy.action_to_ctrl(rng.uniform(-1, 1, len(action))))
   ctrl, rest = healthy.action_to_ctrl(action), healthy.action_to_ctrl(np.zeros_like(action))
-  forces = {label: _actuator_forces(model, qpos, qvel, c) - _actuator_forces(model, qpos, qvel, rest)
-            for label, model, c in (("healthy", healthy_model, ctrl), ("faulty", faulty_model, ctrl))}
   # The force the action adds (cable tension; bellows pull from its commanded length change).
+  forces = {label: _actuator_forces(model, qpos, qvel, ctrl)
+            - _actuator_forces(model, qpos, qvel, rest)
+            for label, model in (("healthy", healthy_model), ("faulty", faulty_model))}
   for index in range(healthy_model.nu):
     if index in indices:
       assert abs(forces["healthy"][index]) > 1e-3
@@ -202,7 +203,7 @@ def test_retraining_one_column_leaves_the_others_bit_identical():
   faulty = healthy.with_faults([faults.parse("1:1:0")])
   smpl = agents.make("smpl", healthy, 0, "tiny")
   columns = [_state(column) for column in smpl.inverse.columns]
-  retrained = adaptation.retrain_column(smpl, faulty, 0, profiles.get("tiny"))
+  retrained = adaptation.retrain_column(smpl, faulty, profiles.get("tiny"))
   assert retrained.trained_now and retrained.column == 1
   assert retrained.retrained_forward_modules == (1, 2)
   equal = lambda a, b: a.keys() == b.keys() and all(torch.equal(a[name], b[name]) for name in a)
@@ -214,7 +215,7 @@ def test_retraining_one_column_leaves_the_others_bit_identical():
   for healthy_controller, controller in zip(smpl.controllers, retrained.agent.controllers):
     assert not equal(healthy_controller.forward.state_dict(), controller.forward.state_dict())
     assert controller.normalisation is healthy_controller.normalisation
-  cached = adaptation.retrain_column(smpl, faulty, 0, profiles.get("tiny"))
+  cached = adaptation.retrain_column(smpl, faulty, profiles.get("tiny"))
   assert not cached.trained_now and cached.wall_time_s == retrained.wall_time_s
   assert equal(_state(retrained.agent.inverse), cached.agent.inverse.state_dict())
 
@@ -223,7 +224,7 @@ def test_the_kept_forward_models_are_bit_identical():
   healthy = robots.make("tendon-2")
   smpl = agents.make("smpl", healthy, 0, "tiny")
   retrained = adaptation.retrain_column(
-      smpl, healthy.with_faults([faults.parse("2:0:0.3")]), 0, profiles.get("tiny"))
+      smpl, healthy.with_faults([faults.parse("2:0:0.3")]), profiles.get("tiny"))
   kept, changed = (controller.forward.state_dict() for controller in retrained.agent.controllers)
   assert all(torch.equal(tensor, kept[name])
              for name, tensor in smpl.controllers[0].forward.state_dict().items())

@@ -115,10 +115,11 @@ def write_wall_time(path: pathlib.Path, seconds: float) -> None:
                            json.dumps({"wall_time_s": seconds}) + "\n")
 
 
-def retrain_column(agent: learned.LearnedAgent, faulty_robot: robot_base.SoftArm, seed: int,
+def retrain_column(agent: learned.LearnedAgent, faulty_robot: robot_base.SoftArm,
                    profile: profiles.Profile, show_progress: bool = False) -> RetrainedColumn:
-  """``agent`` (the smpl agent of the healthy robot) with the faulty module's column retrained,
-  from the cache or trained now and then cached (module docstring).
+  """``agent`` (the smpl agent built for the healthy robot with ``profile``) with the faulty
+  module's column retrained, from the cache or trained now and then cached (module docstring);
+  the retraining is seeded by the agent's seed.
 
   Raises:
     ValueError: the agent is not a progressive (smpl) agent, or the faults are not all in one
@@ -126,7 +127,7 @@ def retrain_column(agent: learned.LearnedAgent, faulty_robot: robot_base.SoftArm
   """
   if not isinstance(agent.inverse, progressive.ProgressiveLSTM):
     raise ValueError("only the smpl agent (one column per module) retrains a single column")
-  module = faulty_module(faulty_robot)
+  module, seed = faulty_module(faulty_robot), agent.seed
   forward_modules = tuple(range(module, faulty_robot.num_modules + 1))
   healthy = faulty_robot.without_faults()
   config = RetrainedConfig(
@@ -137,7 +138,8 @@ def retrain_column(agent: learned.LearnedAgent, faulty_robot: robot_base.SoftArm
   path = learned.checkpoint_file(config)
   inverse = copy.deepcopy(agent.inverse)
   forwards = [copy.deepcopy(controller.forward).freeze() for controller in agent.controllers]
-  bundle = torch.nn.ModuleDict({"inverse": inverse, "forward_models": torch.nn.ModuleList(forwards)})
+  bundle = torch.nn.ModuleDict({"inverse": inverse,
+                                "forward_models": torch.nn.ModuleList(forwards)})
   trained_now = not path.exists()
   if trained_now:
     dataset = data.collect(faulty_robot, samples=profile.samples, seed=learned.DATA_SEED,

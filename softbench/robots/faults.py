@@ -1,4 +1,4 @@
-"""Actuator faults: a degraded actuator (its gain reduced to a fraction) or a punctured one (gain 0).
+"""Actuator faults: a degraded actuator (gain reduced to a fraction) or a punctured one (gain 0).
 
 A fault names a module (1 at the base), an actuator within it (0-based) and a gain in [0, 1]; the
 text form is ``MODULE:ACTUATOR:GAIN``, e.g. ``2:0:0.3``. An actuator is one MuJoCo actuator, and
