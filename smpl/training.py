@@ -316,13 +316,27 @@ def train_column_jointly(
     config: InverseTrainingConfig = InverseTrainingConfig(),
     device: torch.device | None = None,
     on_epoch_end: Callable[[EpochReport], None] | None = None,
+    column: int | None = None,
 ) -> TrainingResult:
-    """Trains the last of columns 0..M-1 (M = modules in `train`) of a distributed controller,
-    all columns acting together on their own modules (`smpl.rollout.joint_rollout`); the loss
-    is the action MSE of that column's module. Earlier columns must be trained and frozen."""
-    column = len(train.modules) - 1
-    if any(parameter.requires_grad for parameter in network.columns[:column].parameters()):
-        raise ValueError("the earlier columns must be frozen before the next one trains")
+    """Trains one of columns 0..M-1 (M = modules in `train`) of a distributed controller, all
+    columns acting together on their own modules (`smpl.rollout.joint_rollout`).
+
+    By default the column is the last, M-1, and the loss is the action MSE of its module; every
+    earlier column must be trained and frozen. Given an earlier `column` (retraining it, e.g.
+    after an actuator fault), the loss is the mean action MSE of modules `column`..M-1, every
+    module whose column reads it through the lateral connections, and every other column must
+    be frozen.
+    """
+    last = len(train.modules) - 1
+    if column is not None and not 0 <= column <= last:
+        raise ValueError(f"column must be 0 to {last} for {last + 1} modules, got {column}")
+    column = last if column is None else column
+    others = [network.columns[index] for index in range(len(network.columns)) if index != column]
+    if any(parameter.requires_grad for other in others for parameter in other.parameters()):
+        raise ValueError(
+            "the earlier columns must be frozen before the next one trains" if column == last
+            else f"every column but {column} must be frozen to retrain it"
+        )
     if not all(model.is_frozen for model in forward_models):
         raise ValueError("the forward models must be trained and frozen before the inverse model")
     device = device if device is not None else default_device()
@@ -330,8 +344,12 @@ def train_column_jointly(
         model.to(device).eval()
 
     def loss(windows: ModuleWindows) -> Tensor:
-        result = joint_rollout(network, windows, forward_models, config.feed_back_error)[column]
-        return nn.functional.mse_loss(result.actions, windows.modules[column].actions)
+        results = joint_rollout(network, windows, forward_models, config.feed_back_error)
+        losses = [
+            nn.functional.mse_loss(results[index].actions, windows.modules[index].actions)
+            for index in range(column, last + 1)
+        ]
+        return sum(losses[1:], losses[0]) / len(losses)
 
     return fit(network, loss, train, validation, config, device, on_epoch_end)
 

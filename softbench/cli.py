@@ -13,6 +13,7 @@ from softbench import data
 from softbench import leaderboard
 from softbench import plots
 from softbench import profiles
+from softbench import retrain as retrain_module
 from softbench import robots
 from softbench import run as run_module
 from softbench import suite
@@ -100,7 +101,7 @@ def _run_protocol(args: argparse.Namespace) -> None:
                                     ("--trajectory", args.trajectory), ("--video", args.video),
                                     ("--module", args.module), ("--targets", args.targets),
                                     ("--helpers", args.helpers)) if value is not None]
-  given += ["--adaptive"] if args.adaptive else []
+  given += (["--adaptive"] if args.adaptive else []) + (["--fault"] if args.fault else [])
   if given or args.eval != "physics":
     raise ValueError(f"--protocol {args.protocol} fixes its robots, tasks and loops; drop "
                      f"{', '.join(given) or '--eval'}")
@@ -147,7 +148,7 @@ def _run(args: argparse.Namespace) -> None:
     raise ValueError("softbench run needs --task TASK (or --protocol exp1s)")
   settings = run_module.settings(args.task, args.agent, args.robot, args.seeds, args.profile,
                                  args.eval, args.trajectory, args.module, args.adaptive,
-                                 args.targets, args.helpers)
+                                 args.targets, args.helpers, tuple(args.fault))
   if args.video and settings.adaptive:
     raise ValueError("--video renders one seed's episode; --adaptive draws its own figure")
   if args.video:
@@ -202,6 +203,23 @@ def _leaderboard(args: argparse.Namespace) -> None:
   if args.write:
     for path in leaderboard.write(board, results, pathlib.Path(args.out)):
       print(f"wrote {path}")
+
+
+def _retrain(args: argparse.Namespace) -> None:
+  settings = retrain_module.settings(args.agent, args.robot, tuple(args.fault), args.profile,
+                                     args.task, args.seeds, args.baseline)
+  record = retrain_module.execute(settings)
+  print(retrain_module.table(record))
+  path = retrain_module.record_path(record, pathlib.Path(args.results))
+  run_module.write_record(record, path)
+  print(f"result record: {path}")
+  if args.json:
+    run_module.write_record(record, pathlib.Path(args.json))
+
+
+_FAULT_HELP = ("a faulty actuator, MODULE:ACTUATOR:GAIN (module from 1, actuator from 0 within "
+               "the module: cable xpos, ypos, xneg, yneg of a tendon arm, bellows 1.. of the "
+               "pneumatic arm; gain in [0, 1], 0 punctured); repeat for several")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -260,6 +278,8 @@ def build_parser() -> argparse.ArgumentParser:
   run_parser.add_argument("--json", help="also write the result record to this file")
   run_parser.add_argument("--video", help="also render seed 0's episode to this .mp4 file")
   _add_video_arguments(run_parser)
+  run_parser.add_argument("--fault", action="append", default=[],
+                          help=_FAULT_HELP + "; the agent is trained on the healthy robot")
   run_parser.set_defaults(run=_run)
   board_parser = commands.add_parser(
       "leaderboard", help="rank the result records per robot and task",
@@ -292,6 +312,30 @@ def build_parser() -> argparse.ArgumentParser:
   render_parser.add_argument("--trajectory", help="target poses for --task custom (.npy or .csv)")
   _add_video_arguments(render_parser)
   render_parser.set_defaults(run=_render)
+  retrain_parser = commands.add_parser(
+      "retrain", help="retrain the faulty module's SMPL column after an actuator fault",
+      description="Collects babbling on the faulty robot, retrains only the faulty module's "
+                  "column of the smpl agent (and the forward models from that module on), and "
+                  "compares the errors before the fault, under it, after retraining one column "
+                  "and of a centralised baseline retrained from scratch, with wall times.")
+  retrain_parser.add_argument("--agent", default=retrain_module.RETRAINED_AGENT,
+                              help="the agent to adapt (smpl, the default, is the only one)")
+  retrain_parser.add_argument("--robot", help="default: the task's robot in the paper")
+  retrain_parser.add_argument("--fault", action="append", default=[], help=_FAULT_HELP +
+                              "; every fault in one module")
+  retrain_parser.add_argument("--task", default=retrain_module.DEFAULT_TASK,
+                              help=f"default {retrain_module.DEFAULT_TASK}")
+  retrain_parser.add_argument("--baseline", default=retrain_module.DEFAULT_BASELINE,
+                              help=f"centralised baseline retrained from scratch (default "
+                                   f"{retrain_module.DEFAULT_BASELINE})")
+  retrain_parser.add_argument("--seeds", type=int, help="number of seeds (default: the profile's)")
+  retrain_parser.add_argument("--profile", default=profiles.DEFAULT_PROFILE,
+                              help=f"one of {', '.join(profiles.PROFILES)} "
+                                   f"(default {profiles.DEFAULT_PROFILE})")
+  retrain_parser.add_argument("--results", default="leaderboard/results",
+                              help="folder of the result records (default leaderboard/results)")
+  retrain_parser.add_argument("--json", help="also write the result record to this file")
+  retrain_parser.set_defaults(run=_retrain)
   models = commands.add_parser("models", help="exported MJCF models")
   models_commands = models.add_subparsers(dest="models_command", required=True)
   export_parser = models_commands.add_parser("export", help="write models/<name>/ for every robot")

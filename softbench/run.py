@@ -8,6 +8,9 @@ deviation over seeds. Every run writes a result record with full provenance.
 With ``adaptive`` (task ``reach``, a learned agent), one agent (seed 0) reaches ``targets``
 virtual targets with adaptive module activation instead (``softbench.adaptive``); the record
 then holds an ``adaptive`` section and no per-seed scores.
+
+With ``faults`` (``--fault MODULE:ACTUATOR:GAIN``, ``softbench.robots.faults``) the agent is
+built for the healthy robot, as a deployed controller would be, and evaluated on the faulty one.
 """
 
 from concurrent import futures
@@ -37,6 +40,7 @@ from softbench.agents import learned
 from softbench.data import dataset
 from softbench.leaderboard import records
 from softbench.suite import reach
+from softbench.robots import faults as fault_model
 
 PAPER_ROBOT = {"babbling": "tendon-3", "circle": "tendon-3", "rectangle": "tendon-3",
                "spiral": "tendon-3", "custom": "tendon-3", "reach": "pneumatic-433"}
@@ -62,27 +66,32 @@ class RunSettings:
   adaptive: bool = False
   targets: int | None = None  # Virtual targets of an adaptive run.
   helpers: str | None = None  # Targets of the other modules in an adaptive run.
+  faults: tuple[fault_model.Fault, ...] = ()
 
 
 def settings(task: str, agent: str, robot: str | None = None, seeds: int | None = None,
              profile: str = profiles.DEFAULT_PROFILE, eval_mode: str = "physics",
              trajectory: str | None = None, module: int | None = None, adaptive: bool = False,
-             targets: int | None = None, helpers: str | None = None) -> RunSettings:
-  """Checked settings, with the defaults filled in.
+             targets: int | None = None, helpers: str | None = None,
+             faults: tuple[str, ...] = ()) -> RunSettings:
+  """Checked settings, with the defaults filled in; ``faults`` as ``MODULE:ACTUATOR:GAIN`` text.
 
   Raises:
     ValueError: unknown task, agent, robot, profile or eval mode, seeds < 1, a trajectory
       without the custom task or the custom task without one, a module with another task than
       reach or out of range, adaptive with another task than reach, a non-learned agent or
-      more than one seed, targets or helpers without adaptive, targets < 1, unknown helpers
-      (one line).
+      more than one seed, targets or helpers without adaptive, targets < 1, unknown helpers,
+      a malformed fault or one that names no actuator of the robot (one line).
   """
   suite.describe(task)
   agents.describe(agent)
   chosen = profiles.get(profile)
   robot = robot or PAPER_ROBOT[task]
-  robots.make(robot)
+  parsed_faults = tuple(fault_model.parse(text) for text in faults)
+  robots.make(robot).with_faults(parsed_faults)
   _check_adaptive(task, agent, robot, seeds, module, adaptive, targets, helpers)
+  if adaptive and parsed_faults:
+    raise ValueError("--fault and --adaptive do not go together yet")
   seeds = (1 if adaptive else chosen.seeds) if seeds is None else seeds
   dataset.check_count("seeds", seeds)
   if eval_mode not in learned.ERROR_SOURCES:
@@ -95,7 +104,7 @@ def settings(task: str, agent: str, robot: str | None = None, seeds: int | None 
     helpers = adaptive_activation.experiment.DEFAULT_HELPERS if helpers is None else helpers
   return RunSettings(task, agent, robot, seeds, chosen, eval_mode,
                      None if trajectory is None else str(trajectory), module, adaptive, targets,
-                     helpers)
+                     helpers, parsed_faults)
 
 
 def _check_adaptive(task: str, agent: str, robot: str, seeds: int | None, module: int | None,
@@ -158,24 +167,43 @@ def _machine() -> dict:
           "torch": torch.__version__, "device": str(learned.training.default_device())}
 
 
-def seed_episode(run: RunSettings, seed: int, show_progress: bool = False) -> evaluation.Episode:
-  """Builds (trains) the agent of ``seed`` and runs it through one episode (environment seed
-  ``seed``)."""
-  arm = robots.make(run.robot)
-  agent = agents.make(run.agent, arm, seed, run.profile, show_progress)
+def episode_on(agent: agents.Agent, arm: robots.SoftArm, run: RunSettings, seed: int,
+               show_progress: bool = False) -> evaluation.Episode:
+  """One episode of ``run``'s task (environment seed ``seed``) by ``agent`` on ``arm``, which may
+  be a faulty robot."""
   if isinstance(agent, learned.LearnedAgent):
     agent.error_source = run.eval_mode
   env = suite.load(arm, run.task, seed=seed, **task_options(run))
   return evaluation.run_episode(env, agent, run.task, show_progress)
 
 
+def seed_entry(seed: int, episode: evaluation.Episode, arm: robots.SoftArm) -> dict:
+  """The record's entry of one seed's episode."""
+  return {"seed": seed, "steps": len(episode.actions),
+          "mean_reward": float(episode.rewards.mean()),
+          **_seed_scores(episode.score(arm.length))}
+
+
+def evaluate(agent: agents.Agent, arm: robots.SoftArm, run: RunSettings, seed: int,
+             show_progress: bool = False) -> tuple[dict, tuple[int, ...]]:
+  """``episode_on``, scored: the seed's record entry and the scored modules."""
+  episode = episode_on(agent, arm, run, seed, show_progress)
+  return seed_entry(seed, episode, arm), episode.scored_modules
+
+
+def seed_episode(run: RunSettings, seed: int, show_progress: bool = False) -> evaluation.Episode:
+  """Builds (trains) the agent of ``seed`` for the healthy robot, as a deployed controller would
+  be, and runs it through one episode on the robot with ``run.faults``."""
+  arm = robots.make(run.robot)
+  agent = agents.make(run.agent, arm, seed, run.profile, show_progress)
+  return episode_on(agent, arm.with_faults(run.faults), run, seed, show_progress)
+
+
 def _run_seed(seed: int, run: RunSettings,
               show_progress: bool) -> tuple[dict, evaluation.Episode]:
-  """The episode of ``seed`` and its scores."""
+  """The episode of ``seed`` (``seed_episode``) and its record entry."""
   episode = seed_episode(run, seed, show_progress)
-  return ({"seed": seed, "steps": len(episode.actions),
-           "mean_reward": float(episode.rewards.mean()),
-           **_seed_scores(episode.score(robots.make(run.robot).length))}, episode)
+  return seed_entry(seed, episode, robots.make(run.robot).with_faults(run.faults)), episode
 
 
 def _ignore_interrupts() -> None:
@@ -251,6 +279,7 @@ def execute_episodes(run: RunSettings, show_progress: bool = True, workers: int 
   """``execute``, also returning every seed's episode (in seed order) for plots and videos;
   none for an adaptive run (``softbench.adaptive`` draws its own figure)."""
   started, origin = time.perf_counter(), provenance()
+  arm = robots.make(run.robot)
   if agents.describe(run.agent).learned:
     data.collect(run.robot, samples=run.profile.samples, seed=learned.DATA_SEED,
                  progress=show_progress)
@@ -268,7 +297,8 @@ def execute_episodes(run: RunSettings, show_progress: bool = True, workers: int 
       "format": RECORD_FORMAT, "version": RECORD_VERSION, **origin,
       "robot": run.robot, "task": run.task, "agent": run.agent, "profile": run.profile.name,
       "profile_settings": dataclasses.asdict(run.profile), "eval_mode": run.eval_mode,
-      "trajectory": run.trajectory, "seeds": run.seeds, **results,
+      "trajectory": run.trajectory, "seeds": run.seeds,
+      "faults": [fault_model.describe(arm, fault) for fault in run.faults], **results,
       "wall_time_s": round(time.perf_counter() - started, 3),
   }
   return record, [] if run.adaptive else [episode for _, episode in outcomes]
@@ -291,7 +321,9 @@ def table(record: dict) -> str:
   columns = {name: summary(record, name) for name, _ in measured}
   rows = [f"module {module}" for module in record["scored_modules"]] + ["mean"]
   header = f"{'':<10}" + "".join(f"{label:>22}" for _, label in measured)
-  lines = [f"{record['agent']} on {record['task']} ({record['robot']}), profile "
+  faulty = record.get("faults") or []
+  under = f" under fault {', '.join(fault['text'] for fault in faulty)}" if faulty else ""
+  lines = [f"{record['agent']} on {record['task']} ({record['robot']}{under}), profile "
            f"{record['profile']}, eval {record['eval_mode']}, {record['seeds']} seed(s): "
            f"mean ± std over seeds", header]
   for index, row in enumerate(rows):
@@ -312,7 +344,9 @@ def date_stamp(record: dict) -> str:
 
 def record_path(record: dict, results: pathlib.Path) -> pathlib.Path:
   task = record["task"] + ("-adaptive" if "adaptive" in record else "")
-  return results / (f"{record['agent']}-{record['robot']}-{task}-{record['profile']}-"
+  faulty = "".join(f"-fault{fault['module']}.{fault['actuator']}.{fault['gain']:g}"
+                   for fault in record.get("faults") or [])
+  return results / (f"{record['agent']}-{record['robot']}{faulty}-{task}-{record['profile']}-"
                     f"{record['eval_mode']}-{date_stamp(record)}.json")
 
 

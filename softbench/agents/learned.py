@@ -31,6 +31,7 @@ those of the unmasked agent, bit for bit.
 import contextlib
 import dataclasses
 import hashlib
+import pathlib
 from typing import Callable
 
 import numpy as np
@@ -275,16 +276,35 @@ def _train(name: str, robot: robot_base.SoftArm, views: list[data.View], seed: i
   return inverse, forwards, normalisations
 
 
+def _views(robot: robot_base.SoftArm, per_module: bool) -> list[data.View]:
+  return ([data.View.module(robot, k) for k in range(1, robot.num_modules + 1)] if per_module
+          else [data.View.whole_arm(robot)])
+
+
+def _trained_config(name: str, robot: robot_base.SoftArm, views: list[data.View], seed: int,
+                    profile: profiles.Profile) -> TrainedConfig:
+  return TrainedConfig(name, robot.name, hashlib.sha256(robot.to_xml().encode()).hexdigest(),
+                       tuple(view.name for view in views), profile.samples, seed,
+                       profile.max_epochs, profile.patience, profile.compile)
+
+
+def checkpoint_path(name: str, robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
+                    per_module: bool) -> pathlib.Path:
+  """Where ``build_agent`` caches the agent's checkpoint (it exists once trained)."""
+  return checkpoint_file(_trained_config(name, robot, _views(robot, per_module), seed, profile))
+
+
+def checkpoint_file(config) -> pathlib.Path:
+  return storage.softbench_home() / CHECKPOINT_FOLDER / f"{config.key}.pt"
+
+
 def build_agent(name: str, robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
                 per_module: bool, make_model: ModelFactory | None = None,
                 show_progress: bool = False) -> LearnedAgent:
   """A trained learned agent: from the checkpoint cache, or trained now and then cached."""
-  views = ([data.View.module(robot, k) for k in range(1, robot.num_modules + 1)] if per_module
-           else [data.View.whole_arm(robot)])
-  config = TrainedConfig(name, robot.name, hashlib.sha256(robot.to_xml().encode()).hexdigest(),
-                         tuple(view.name for view in views), profile.samples, seed,
-                         profile.max_epochs, profile.patience, profile.compile)
-  path = storage.softbench_home() / CHECKPOINT_FOLDER / f"{config.key}.pt"
+  views = _views(robot, per_module)
+  config = _trained_config(name, robot, views, seed, profile)
+  path = checkpoint_file(config)
   if path.exists():
     inverse, forwards = untrained(views, per_module, make_model)
     arrays = checkpoint.load_checkpoint(path, bundle(inverse, forwards), config)

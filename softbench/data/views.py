@@ -99,8 +99,11 @@ class SplitWindows:
 
 def windows(data: dataset.Dataset, view: View,
             window_length: int = smpl_windows.SEQUENCE_LENGTH, stride: int = 1,
-            fractions: tuple[float, ...] = splits.FRACTIONS) -> SplitWindows:
-  """``view``'s windows of each split of ``data`` (see the module docstring).
+            fractions: tuple[float, ...] = splits.FRACTIONS,
+            fitted: normalisation.Normalisation | None = None) -> SplitWindows:
+  """``view``'s windows of each split of ``data`` (see the module docstring), normalised with
+  ``fitted`` if given (e.g. a trained controller's, to retrain it on new data) instead of
+  statistics fitted on this dataset's training split.
 
   Raises:
     ValueError: the view does not fit the dataset, or a split holds no window.
@@ -116,7 +119,8 @@ def windows(data: dataset.Dataset, view: View,
     return normalisation.MinMaxNormaliser.fit(
         np.concatenate([recording[part] for recording in recordings["train"]]))
 
-  fitted = normalisation.Normalisation(poses=fit(0), actions=fit(1), preceding_actions=fit(2))
+  if fitted is None:
+    fitted = normalisation.Normalisation(poses=fit(0), actions=fit(1), preceding_actions=fit(2))
   cut = {split: _cut(split, recordings[split], fitted, window_length, stride)
          for split in splits.SPLITS}
   return SplitWindows(view=view, normalisation=fitted, **cut)

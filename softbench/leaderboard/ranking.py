@@ -120,6 +120,7 @@ class Leaderboard:
 
 def _group_key(record: dict) -> tuple[str, str, str]:
   variant = [f"trajectory {record['trajectory']}"] if record["trajectory"] is not None else []
+  variant += [f"fault {fault['text']}" for fault in record.get("faults") or []]
   variant += [f"with {name}" for name in records.sections(record)]
   return record["robot"], record["task"], ", ".join(variant)
 

@@ -40,7 +40,7 @@ INTEGRITY_FIELD = record_fields.INTEGRITY_FIELD
 METRICS = ("position_mm", "orientation_deg", "normalised_tip_percent")
 """Errors a record may hold per seed; position and normalised tip error always, orientation
 except for position-only tasks (reach)."""
-_OPTIONAL_FIELDS = ("video",)
+_OPTIONAL_FIELDS = ("video", "faults")
 ADAPTIVE_SECTION = "adaptive"  # softbench run --adaptive: per-target results, no per-seed ones.
 _MEAN_TOLERANCE = 1e-9  # Relative: a seed's mean against the mean of its per-module values.
 _MAX_MESSAGE_CHARS = 160  # Of a schema error's message, so that a refusal stays one line.
@@ -80,6 +80,12 @@ def schema() -> dict:
                          "minItems": 1, "uniqueItems": True},
       "per_seed": {"type": "array", "items": seed},  # Empty in adaptive activation records.
       "video": {"type": "string", "minLength": 1},
+      "faults": {"type": "array", "items": {  # softbench.robots.faults.describe
+          "type": "object", "required": ["module", "actuator", "gain", "text"],
+          "properties": {"module": {"type": "integer", "minimum": 1},
+                         "actuator": {"type": "integer", "minimum": 0},
+                         "gain": {"type": "number", "minimum": 0, "maximum": 1},
+                         "text": {"type": "string"}}}},
       **record_fields.properties(),
   }
   return {

@@ -13,6 +13,8 @@ import math
 import mujoco
 import numpy as np
 
+from softbench.robots import faults as fault_model
+
 ACTION_MAP_NAME = "action_map"
 
 
@@ -44,7 +46,13 @@ def action_to_ctrl(action_map: np.ndarray, action: np.ndarray) -> np.ndarray:
 
 
 class SoftArm(abc.ABC):
-  """Base of the frozen spec dataclasses of every robot family."""
+  """Base of the frozen spec dataclasses of every robot family.
+
+  Every family has a ``faults`` field: a tuple of ``softbench.robots.faults.Fault`` (empty for a
+  healthy robot), applied to the actuators' gains when the MJCF is built.
+  """
+
+  faults: tuple[fault_model.Fault, ...] = ()
 
   @property
   @abc.abstractmethod
@@ -133,12 +141,22 @@ class SoftArm(abc.ABC):
     return dataclasses.replace(self, segments_per_module=self.segments_per_module * factor,
                                timestep=self.timestep / factor)
 
+  def with_faults(self, faults) -> "SoftArm":
+    """The same robot with ``faults`` (an iterable of ``Fault``) instead of its own; raises a
+    one-line ValueError for a fault that names no actuator of this robot."""
+    return dataclasses.replace(self, faults=tuple(faults))
+
+  def without_faults(self) -> "SoftArm":
+    """The robot as designed (healthy)."""
+    return self.with_faults(()) if self.faults else self
+
   def build_spec(self) -> mujoco.MjSpec:
     """A fresh ``MjSpec`` of this robot, ready to compile or export."""
     spec = mujoco.MjSpec()
     spec.modelname = self.name
     spec.compiler.degree = False
     self._build(spec)
+    fault_model.apply(spec, self)
     spec.add_numeric(name=ACTION_MAP_NAME, data=self.action_map().ravel().tolist())
     return spec
 

@@ -90,9 +90,14 @@ def readme(robot: base.SoftArm, speed: dict | None) -> str:
 
 
 def spec_fields(robot: base.SoftArm):
-  """(field, printable value) of every field of the robot's spec."""
+  """(field, printable value) of every field of the robot's spec; ``faults`` only when there
+  are some (exported models are healthy)."""
   for field in robot.__dataclass_fields__:
     value = getattr(robot, field)
+    if field == "faults":
+      if value:
+        yield field, ", ".join(map(str, value))
+      continue
     yield field, (f"{value:g}" if isinstance(value, float) else value)
 
 

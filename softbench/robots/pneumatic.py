@@ -17,6 +17,7 @@ import numpy as np
 
 from softbench.robots import base
 from softbench.robots import chain
+from softbench.robots import faults as fault_model
 
 MODULE_LENGTH = 0.08  # (m) Paper: "Each actuator is 80mm long".
 BELLOWS_PER_MODULE = (4, 3, 3)  # Paper: 4 at 90 degrees at the base, then 3 at 120 degrees.
@@ -59,6 +60,8 @@ class PneumaticArm(base.SoftArm):
     armature: Added inertia of every joint DOF (kg·m² or kg).
     timestep: Physics time step (s).
     control_period: Time between two actions (s); the paper actuates the robot at 5 Hz.
+    faults: Faulty bellows (``softbench.robots.faults``; actuator i of a module is its bellows
+      i + 1); empty for a healthy arm.
   """
 
   module_length: float = MODULE_LENGTH
@@ -77,6 +80,7 @@ class PneumaticArm(base.SoftArm):
   armature: float = 1.0e-5
   timestep: float = 1.0e-3
   control_period: float = 0.2
+  faults: tuple[fault_model.Fault, ...] = ()
 
   def __post_init__(self):
     for field in ("module_length", "bellows_offset", "bellows_radius", "bellows_stiffness",
@@ -90,6 +94,7 @@ class PneumaticArm(base.SoftArm):
     if not isinstance(self.segments_per_module, int) or self.segments_per_module < 1:
       raise ValueError(f"segments_per_module must be a positive integer, "
                        f"got {self.segments_per_module!r}")
+    fault_model.check(self, self.faults)
 
   @property
   def name(self) -> str:

@@ -22,6 +22,7 @@ import numpy as np
 
 from softbench.robots import base
 from softbench.robots import chain
+from softbench.robots import faults as fault_model
 
 MODULE_LENGTH = 0.05  # (m) Paper: "Each module has a length of 50 mm".
 MAX_MODULES = 10  # Largest N that builds; tendon-1 .. tendon-5 are the benchmark configurations.
@@ -65,6 +66,8 @@ class TendonArm(base.SoftArm):
     backbone: ``"cable"`` (cable plugin) or ``"joints"`` (ball-joint springs, no plugin).
     timestep: Physics time step (s).
     control_period: Time between two actions (s).
+    faults: Faulty cables (``softbench.robots.faults``; actuator i of a module is cable
+      ``xpos``, ``ypos``, ``xneg``, ``yneg`` for i = 0 .. 3); empty for a healthy arm.
   """
 
   num_modules: int = 3
@@ -84,6 +87,7 @@ class TendonArm(base.SoftArm):
   backbone: str = "cable"
   timestep: float = 4.0e-3
   control_period: float = 1.0
+  faults: tuple[fault_model.Fault, ...] = ()
 
   def __post_init__(self):
     if (isinstance(self.num_modules, bool) or not isinstance(self.num_modules, int)
@@ -104,6 +108,7 @@ class TendonArm(base.SoftArm):
       raise ValueError(f"poisson_ratio must lie in [0, 0.5], got {self.poisson_ratio!r}")
     if self.backbone not in BACKBONES:
       raise ValueError(f"unknown backbone {self.backbone!r}; choose one of {', '.join(BACKBONES)}")
+    fault_model.check(self, self.faults)
 
   @classmethod
   def from_name(cls, name: str, **overrides) -> "TendonArm":

@@ -75,6 +75,9 @@ def load(robot: str | robots.SoftArm, task: str, seed=None, environment_kwargs: 
          **task_kwargs) -> control.Environment:
   """The environment of ``task`` on ``robot`` (a name such as ``tendon-3``, or a robot spec).
 
+  The physics is ``robot``'s, faults included (``robot.with_faults``); the targets are those of
+  the healthy robot, so that errors with and without a fault compare.
+
   Args:
     robot: robot name or ``SoftArm`` instance.
     task: one of ``TASKS``.
@@ -95,7 +98,8 @@ def load(robot: str | robots.SoftArm, task: str, seed=None, environment_kwargs: 
   if unknown:
     raise ValueError(f"task {task!r} has no option {unknown[0]!r}; its options: "
                      f"{', '.join(sorted(options))}")
-  built = entry.build(arm, random=seed, **task_kwargs)
+  # Targets come from the robot as designed: an actuator fault changes the physics, not the task.
+  built = entry.build(arm.without_faults(), random=seed, **task_kwargs)
   physics = arm_physics.SoftArmPhysics.from_robot(arm)
   return control.Environment(physics, built, control_timestep=arm.control_timestep,
                              **(environment_kwargs or {}))

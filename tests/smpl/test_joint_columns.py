@@ -86,6 +86,33 @@ def test_joint_training_refuses_unfrozen_earlier_columns(modules) -> None:
                              InverseTrainingConfig(max_epochs=1), torch.device("cpu"))
 
 
+def test_retraining_an_earlier_column_leaves_the_later_one_bit_identical(modules) -> None:
+    """Retraining column 0 (an actuator fault in module 1): the loss covers both modules, since
+    column 1 reads column 0 laterally, and column 1's parameters stay bit-identical."""
+    network, forwards = _network(), _forward_models()
+    network.columns.requires_grad_(False)
+    network.columns[0].requires_grad_(True)
+    later = {name: value.clone() for name, value in network.columns[1].state_dict().items()}
+    before = [p.clone() for p in network.columns[0].parameters()]
+    config = InverseTrainingConfig(max_epochs=2, patience=2)
+    train_column_jointly(network, forwards, modules, modules, config, torch.device("cpu"),
+                         column=0)
+    after = network.columns[1].state_dict()
+    assert all(torch.equal(later[name], after[name]) for name in later)
+    assert any(not torch.equal(a, b) for a, b in zip(before, network.columns[0].parameters()))
+
+
+def test_retraining_refuses_other_unfrozen_columns_and_a_missing_column(modules) -> None:
+    network = _network()  # add_column left the last column trainable.
+    network.columns[0].requires_grad_(True)
+    with pytest.raises(ValueError, match="every column but 0 must be frozen"):
+        train_column_jointly(network, _forward_models(), modules, modules,
+                             InverseTrainingConfig(max_epochs=1), torch.device("cpu"), column=0)
+    with pytest.raises(ValueError, match="column must be 0 to 1"):
+        train_column_jointly(network, _forward_models(), modules, modules,
+                             InverseTrainingConfig(max_epochs=1), torch.device("cpu"), column=2)
+
+
 def test_module_windows_must_be_aligned(make_arm_windows) -> None:
     with pytest.raises(ValueError, match="not aligned"):
         ModuleWindows((make_arm_windows(60, 4, seed=0), make_arm_windows(50, 3, seed=1)))
