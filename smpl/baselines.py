@@ -1,6 +1,8 @@
 """The learned baselines the paper compares SMPL with, all behind the InverseModel interface.
 
-Sizes are defaults to start a hyperparameter search from (the paper tuned them with Optuna).
+The sizes below are the constructors' defaults. The agents build these models with the values
+committed in `softbench/agents/hyperparameters.json`, chosen on validation data with Optuna as in
+the paper (`softbench tune`); these defaults were the first trial of each study.
 """
 
 from __future__ import annotations

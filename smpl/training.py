@@ -7,7 +7,9 @@ model (see `smpl.rollout` for the exact time indexing).
 
 Inverse-model loss: MSE between predicted and babbling actions (supervised, as in the paper), plus
 the model's aux loss (the VAE's beta * KL), plus optionally `pose_loss_weight` times the MSE between
-the forward model's predicted poses and the targets (off by default).
+the forward model's predicted poses and the targets (off by default). The aux loss is a training
+regulariser only: validation, and so early stopping and the best weights kept, leaves it out, which
+makes every inverse model's validation loss the same quantity.
 """
 
 from __future__ import annotations
@@ -55,6 +57,8 @@ class TrainingConfig:
 
     batch_size: int
     learning_rate: float = LEARNING_RATE
+    weight_decay: float = 0.0
+    """Adam's L2 penalty on the trainable weights (0: none, as in the paper)."""
     max_epochs: int = MAX_EPOCHS
     patience: int = PATIENCE
     seed: int = 0
@@ -167,11 +171,12 @@ def fit(
     config: TrainingConfig,
     device: torch.device | None = None,
     on_epoch_end: Callable[[EpochReport], None] | None = None,
+    validation_loss: BatchLoss | None = None,
 ) -> TrainingResult:
     """Trains the trainable parameters of `model` to minimise `batch_loss` on `train`.
 
     Each epoch shuffles the training windows, takes one Adam step per batch, then scores the whole
-    validation set. Training stops after `config.max_epochs` or when the validation loss has not
+    validation set with `validation_loss` (default: `batch_loss`). Training stops after `config.max_epochs` or when the validation loss has not
     improved for `config.patience` epochs; the model ends with the weights of its best epoch, in
     eval mode. The same config and data give the same weights. `batch_loss` must use tensors on
     the model's device: `fit` moves `model` and the windows there, nothing else.
@@ -184,7 +189,9 @@ def fit(
     train = train.to(device)
     validation = validation.to(device)
     with seeded(config.seed, device), limited_cpu_threads(config.cpu_threads, device):
-        optimizer = torch.optim.Adam(parameters, lr=config.learning_rate)
+        optimizer = torch.optim.Adam(
+            parameters, lr=config.learning_rate, weight_decay=config.weight_decay
+        )
         train_loss_of, step = batch_loss, optimizer.step
         if config.compile:
             train_loss_of, step = _compiled(batch_loss), _compiled(optimizer.step)
@@ -198,14 +205,14 @@ def fit(
             train_loss = _train_epoch(
                 train_loss_of, step, optimizer, train, config.batch_size, shuffling
             )
-            validation_loss = evaluate_loss(model, batch_loss, validation)
-            improved = stopping.update(epoch, validation_loss)
+            epoch_validation_loss = evaluate_loss(model, validation_loss or batch_loss, validation)
+            improved = stopping.update(epoch, epoch_validation_loss)
             if improved:
                 best_state = _copy_state(model)
             report = EpochReport(
                 epoch,
                 train_loss,
-                validation_loss,
+                epoch_validation_loss,
                 stopping.best_loss,
                 improved,
                 time.perf_counter() - started,
@@ -245,13 +252,17 @@ def inverse_model_loss(
     windows: BabblingWindows,
     feed_back_error: bool = True,
     pose_loss_weight: float = 0.0,
+    include_aux_loss: bool = True,
 ) -> Tensor:
-    """Action MSE of a rollout, plus aux loss, plus the optional pose term (module docstring)."""
+    """Action MSE of a rollout, plus aux loss (unless `include_aux_loss` is false), plus the
+    optional pose term (module docstring)."""
     needs_forward_model = feed_back_error or pose_loss_weight > 0
     result = rollout(
         inverse_model, windows, forward_model if needs_forward_model else None, feed_back_error
     )
-    loss = nn.functional.mse_loss(result.actions, windows.actions) + result.aux_loss
+    loss = nn.functional.mse_loss(result.actions, windows.actions)
+    if include_aux_loss:
+        loss = loss + result.aux_loss
     if pose_loss_weight > 0:
         loss = loss + pose_loss_weight * nn.functional.mse_loss(
             result.predicted_poses, windows.next_poses
@@ -290,21 +301,32 @@ def train_inverse_model(
     device: torch.device | None = None,
     on_epoch_end: Callable[[EpochReport], None] | None = None,
 ) -> TrainingResult:
-    """Trains an inverse model (any of them, including the last SMPL column) through the loop."""
+    """Trains an inverse model (any of them, including the last SMPL column) through the loop;
+    validation leaves out the model's aux loss (module docstring)."""
     if not forward_model.is_frozen:
         raise ValueError("the forward model must be trained and frozen before the inverse model")
     device = device if device is not None else default_device()
     forward_model.to(device).eval()
+
+    def loss(windows: BabblingWindows, include_aux_loss: bool = True) -> Tensor:
+        return inverse_model_loss(
+            inverse_model,
+            forward_model,
+            windows,
+            config.feed_back_error,
+            config.pose_loss_weight,
+            include_aux_loss,
+        )
+
     return fit(
         inverse_model,
-        lambda windows: inverse_model_loss(
-            inverse_model, forward_model, windows, config.feed_back_error, config.pose_loss_weight
-        ),
+        loss,
         train,
         validation,
         config,
         device,
         on_epoch_end,
+        validation_loss=lambda windows: loss(windows, include_aux_loss=False),
     )
 
 

@@ -17,7 +17,9 @@ from softbench import retrain as retrain_module
 from softbench import robots
 from softbench import run as run_module
 from softbench import suite
+from softbench import tuning
 from softbench.adaptive import plot as adaptive_plot
+from softbench.agents import hyperparameters
 from softbench.data import seeding
 from softbench.rendering import options as video_options
 from softbench.rendering import replay as episode_replay
@@ -87,6 +89,51 @@ def _agents(args: argparse.Namespace) -> None:
   for name in agents.AGENTS:
     entry = agents.describe(name)
     print(f"{name:<10} {'yes' if entry.learned else 'no':<7} {entry.description}")
+    if args.verbose and entry.learned:
+      for robot, values in hyperparameters.load()["agents"][name].items():
+        study = values["study"]
+        origin = "not tuned"
+        if study is not None:
+          origin = (f"best of {sum(study['trials'].values())} trials on the {study['profile']} "
+                    f"profile: validation MSE {_loss(study['best']['value'])} after "
+                    f"{study['trial_epochs']} epochs")
+          if "full_budget" in study:
+            origin += f", {_loss(study['full_budget']['best'])} after {study['max_epochs']}"
+        settings = ", ".join(f"{key} {value:g}" for key, value in values["params"].items())
+        print(f"{'':<18} {robot}: {settings} ({origin})")
+
+
+def _loss(value: float | None) -> str:
+  return "not finite" if value is None else f"{value:.4g}"
+
+
+def _tune(args: argparse.Namespace) -> None:
+  settings = tuning.settings(args.agent, args.robot, args.trials, args.storage, args.profile,
+                             args.study, args.epochs)
+  summary = tuning.run(settings)
+  if args.confirm:
+    summary = tuning.confirm(settings, summary)
+  best, previous = summary["best"], summary["previous_values"]
+  trials = summary["trials"]
+  print(f"{settings.agent} on {settings.robot}, profile {settings.profile.name}: "
+        f"{trials['complete']} complete, {trials['pruned']} pruned, {trials['fail']} failed")
+  if previous is not None:
+    print(f"previous values (trial {previous['trial']}): validation MSE "
+          f"{_loss(previous['value'])}")
+  if best is not None:
+    print(f"best trial {best['trial']}: validation MSE {_loss(best['value'])}")
+    for key, value in best["params"].items():
+      print(f"  {key} = {value:g}")
+  if "full_budget" in summary:
+    check = summary["full_budget"]
+    print(f"at the profile's {check['epochs']} epochs: previous values "
+          f"{_loss(check['previous'])}, best {_loss(check['best'])}")
+  path = pathlib.Path(args.summary) if args.summary else tuning.summary_path(settings)
+  tuning.write_summary(summary, path)
+  print(f"study summary: {path}")
+  if args.adopt:
+    tuning.adopt(summary)
+    print(f"adopted as {settings.agent}'s values on {settings.robot}: {hyperparameters.PATH}")
 
 
 def _run_protocol(args: argparse.Namespace) -> None:
@@ -243,7 +290,37 @@ def build_parser() -> argparse.ArgumentParser:
                               help="simulation threads (default: every core)")
   collect_parser.set_defaults(run=_collect)
   agents_parser = commands.add_parser("agents", help="list the agents")
+  agents_parser.add_argument("--verbose", action="store_true",
+                             help="also show each learned agent's hyperparameters")
   agents_parser.set_defaults(run=_agents)
+  tune_parser = commands.add_parser(
+      "tune", help="tune a learned agent's hyperparameters with Optuna",
+      description="Runs (or resumes) an Optuna study of the agent's hyperparameters on the "
+                  "babbling validation split; the same budget for every agent.")
+  tune_parser.add_argument("--agent", required=True, help="a learned agent, e.g. smpl or lstm")
+  tune_parser.add_argument("--robot", required=True, help="e.g. tendon-3 or pneumatic-433")
+  tune_parser.add_argument("--trials", type=int, default=tuning.DEFAULT_TRIALS,
+                           help=f"finished trials the study should hold (default "
+                                f"{tuning.DEFAULT_TRIALS}); "
+                                "re-running adds the missing ones")
+  tune_parser.add_argument("--storage", help="Optuna storage URL (default: "
+                                             "sqlite:///$SOFTBENCH_HOME/tuning.db)")
+  tune_parser.add_argument("--profile", default=profiles.DEFAULT_PROFILE,
+                           help=f"data and epoch budget: one of {', '.join(profiles.PROFILES)} "
+                                f"(default {profiles.DEFAULT_PROFILE})")
+  tune_parser.add_argument("--epochs", type=int,
+                           help="epoch budget of each trial's inverse model (default: the "
+                                "profile's; fewer buys more trials)")
+  tune_parser.add_argument("--study", help="study name (default AGENT-ROBOT-PROFILE)")
+  tune_parser.add_argument("--summary", help="where to write the study summary (default "
+                                             "$SOFTBENCH_HOME/tuning/STUDY.json)")
+  tune_parser.add_argument("--confirm", action="store_true",
+                           help="then train the previous and the best values at the profile's "
+                                "full epoch budget and report both")
+  tune_parser.add_argument("--adopt", action="store_true",
+                           help="commit the best values as the agent's hyperparameters on the "
+                                "robot (softbench/agents/hyperparameters.json)")
+  tune_parser.set_defaults(run=_tune)
   run_parser = commands.add_parser(
       "run", help="train (or reuse) an agent and score it on a task over seeds",
       description="Collects or reuses the babbling dataset, trains or reuses the agent (cached "

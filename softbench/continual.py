@@ -33,6 +33,7 @@ from softbench import profiles
 from softbench import protocols
 from softbench import storage
 from softbench import suite
+from softbench.agents import hyperparameters
 from softbench.agents import learned
 from softbench.data import dataset
 
@@ -54,6 +55,7 @@ class Exp1sConfig:
   max_epochs: int
   patience: int
   compile: bool
+  params: tuple[tuple[str, object], ...]  # SMPL's hyperparameters (softbench.agents.hyperparameters)
   training_version: int = learned.TRAINING_VERSION
 
   @property
@@ -83,12 +85,18 @@ class Exp1sModel:
 def _config(seed: int, profile: profiles.Profile, arms: list) -> Exp1sConfig:
   return Exp1sConfig(tuple(arm.name for arm in arms),
                      tuple(hashlib.sha256(arm.to_xml().encode()).hexdigest() for arm in arms),
-                     profile.samples, seed, profile.max_epochs, profile.patience, profile.compile)
+                     profile.samples, seed, profile.max_epochs, profile.patience, profile.compile,
+                     tuple(sorted(_params().items())))
+
+
+def _params() -> dict:
+  """SMPL's hyperparameters (the agent's, tuned on tendon-3; the columns keep the SPEC's size)."""
+  return hyperparameters.values("smpl", protocols.get(PROTOCOL).robot_names[-1])
 
 
 def _train(seed: int, profile: profiles.Profile, show: bool):
   """Column by column over the configurations; returns network, forwards, normalisations, run."""
-  forward_config, inverse_config = learned.training_configs(seed, profile)
+  forward_config, inverse_config = learned.training_configs(seed, profile, _params())
   device = training.default_device()
   network = progressive.ProgressiveLSTM()
   prepared, outcome = [], smpl_protocol.ProgressiveRun(training=[], scores=[])
@@ -120,7 +128,7 @@ def build(seed: int, profile: profiles.Profile, show_progress: bool = False) -> 
   config = _config(seed, profile, arms)
   path = storage.softbench_home() / learned.CHECKPOINT_FOLDER / f"{config.key}.pt"
   if path.exists():
-    network, forwards = learned.untrained(views, True, None)
+    network, forwards = learned.untrained(views, True, None, _params())
     arrays = checkpoint.load_checkpoint(path, learned.bundle(network, forwards), config)
     normalisations = [data.Normalisation.from_arrays(
         {key.removeprefix(f"{arm.name}/"): value for key, value in arrays.items()

@@ -24,7 +24,6 @@ that names the healthy checkpoint and the faults, with the wall time of the retr
 (``<checkpoint>.timing.json``).
 """
 
-import contextlib
 import copy
 import dataclasses
 import hashlib
@@ -35,13 +34,13 @@ import time
 import torch
 
 from smpl import checkpoint
-from smpl import progress
 from smpl import progressive
 from smpl import training
 from smpl import windows as smpl_windows
 from softbench import data
 from softbench import profiles
 from softbench import storage
+from softbench.agents import hyperparameters
 from softbench.agents import learned
 from softbench.robots import base as robot_base
 
@@ -167,25 +166,22 @@ def _retrain(agent: learned.LearnedAgent, inverse: progressive.ProgressiveLSTM,
   and column ``module`` of ``inverse``."""
   windows = [data.windows(dataset, controller.view, fitted=controller.normalisation)
              for controller in agent.controllers]
-  forward_config, inverse_config = learned.training_configs(seed, profile)
+  forward_config, inverse_config = learned.training_configs(
+      seed, profile, hyperparameters.values("smpl", agent.robot.name))
   device = training.default_device()
   label = f"{dataset.robot_name} seed {seed}"
   for index in range(module - 1, len(forwards)):
     forwards[index].requires_grad_(True)
-    with _progress_bar(f"forward module-{index + 1} {label}", profile.max_epochs, show) as bar:
+    with learned.progress_bar(f"forward module-{index + 1} {label}", profile.max_epochs, show) as bar:
       training.train_forward_model(forwards[index], windows[index].train,
                                    windows[index].validation, forward_config, device, bar)
   inverse.requires_grad_(False)
   inverse.columns[module - 1].requires_grad_(True)
   split = lambda name: smpl_windows.ModuleWindows(tuple(getattr(w, name) for w in windows))
-  with _progress_bar(f"inverse column {module} {label}", profile.max_epochs, show) as bar:
+  with learned.progress_bar(f"inverse column {module} {label}", profile.max_epochs, show) as bar:
     training.train_column_jointly(inverse, forwards, split("train"), split("validation"),
                                   inverse_config, device, bar, column=module - 1)
   inverse.requires_grad_(False)
-
-
-def _progress_bar(label: str, epochs: int, show: bool):
-  return progress.EpochProgressBar(label, epochs) if show else contextlib.nullcontext(None)
 
 
 def columns_bit_identical(before: progressive.ProgressiveLSTM,

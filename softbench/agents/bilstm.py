@@ -4,7 +4,9 @@ same closed loop as SMPL."""
 from smpl import baselines
 from softbench.agents import learned
 
+LEARNER = learned.Learner("bilstm", per_module=False, make_model=baselines.BiLSTMInverse)
+
 
 def build(robot, seed, profile, show_progress=False):
-  return learned.build_agent("bilstm", robot, seed, profile, per_module=False,
-                             make_model=baselines.BiLSTMInverse, show_progress=show_progress)
+  return learned.build_agent(LEARNER.name, robot, seed, profile, LEARNER.per_module,
+                             LEARNER.make_model, show_progress)

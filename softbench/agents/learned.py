@@ -4,7 +4,9 @@ Training (cached): the robot's babbling dataset (``softbench.data.collect``, dat
 profile's sample count), cut into each controller's view; a forward model per view, then the
 inverse model in closed loop through it (``smpl.training``), seeded by the agent's seed. SMPL has
 one progressive column per module (``View.module``, trained in order, earlier columns frozen);
-the baselines are one centralised model over the whole arm (``View.whole_arm``).
+the baselines are one centralised model over the whole arm (``View.whole_arm``). Each agent
+trains with its committed hyperparameters (``softbench.agents.hyperparameters``), which enter the
+checkpoint's config, so a change of values never reuses a stale checkpoint.
 
 Acting, at control step t, each controller reads (normalised with its training statistics)
 
@@ -49,16 +51,33 @@ from softbench import profiles
 from softbench import protocols
 from softbench import storage
 from softbench.agents import base
+from softbench.agents import hyperparameters
 from softbench.robots import base as robot_base
 
 ERROR_SOURCES = ("physics", "model", "open-loop")
 HELPER_TARGETS = ("hold", "share")
 CHECKPOINT_FOLDER = "checkpoints"
 DATA_SEED = 0  # Every agent and seed learns from the same babbling dataset.
-TRAINING_VERSION = 2  # Bump when training changes, so cached checkpoints are not reused. 2: SMPL
-# columns train and act together, each on its own module's inputs.
+TRAINING_VERSION = 3  # Bump when training changes, so cached checkpoints are not reused. 2: SMPL
+# columns train and act together, each on its own module's inputs. 3: validation (early stopping)
+# leaves out the VAE's KL term; hyperparameters from hyperparameters.json.
 
-ModelFactory = Callable[[int, int], InverseModel]  # (input_size, action_size) -> model
+ModelFactory = Callable[..., InverseModel]  # (input_size, action_size, **model settings) -> model
+EpochCallback = Callable[[int, float], None]  # (epoch, counted across columns; validation loss)
+
+
+@dataclasses.dataclass(frozen=True)
+class Learner:
+  """How a learned agent's inverse model is made: one progressive column per module
+  (``per_module``), or one centralised model of the whole arm from ``make_model``."""
+
+  name: str
+  per_module: bool
+  make_model: ModelFactory | None = None
+
+  def views(self, robot: robot_base.SoftArm) -> list[data.View]:
+    return ([data.View.module(robot, k) for k in range(1, robot.num_modules + 1)]
+            if self.per_module else [data.View.whole_arm(robot)])
 
 
 @dataclasses.dataclass(frozen=True)
@@ -74,6 +93,7 @@ class TrainedConfig:
   max_epochs: int
   patience: int
   compile: bool
+  hyperparameters: tuple[tuple[str, float | int], ...] = ()  # Sorted (name, value) pairs.
   training_version: int = TRAINING_VERSION
 
   @property
@@ -201,36 +221,45 @@ class LearnedAgent(base.Agent):
                                        as_tensor(previous_action))
 
 
-def training_configs(seed: int, profile: profiles.Profile
+def training_configs(seed: int, profile: profiles.Profile, params: dict | None = None
                      ) -> tuple[training.ForwardTrainingConfig, training.InverseTrainingConfig]:
-  """The forward and inverse training settings of ``profile``, seeded by ``seed``."""
+  """The forward model's config (the paper's, always) and the inverse model's (with ``params``'
+  optimiser settings; ``hyperparameters.values``), seeded by ``seed``."""
   common = dict(max_epochs=profile.max_epochs, patience=profile.patience, seed=seed,
                 compile=profile.compile)
-  return training.ForwardTrainingConfig(**common), training.InverseTrainingConfig(**common)
+  return (training.ForwardTrainingConfig(**common), training.InverseTrainingConfig(
+      **common, **hyperparameters.training_settings(params or {})))
+
+
+def forward_config(seed: int, profile: profiles.Profile) -> training.ForwardTrainingConfig:
+  """How the forward models of an agent trained with ``seed`` and ``profile`` are trained."""
+  return training_configs(seed, profile)[0]
 
 
 def _input_size(view: data.View) -> int:
   return smpl_windows.inverse_input_size(view.pose_size, view.action_size)
 
 
-def _inverse_model(views: list[data.View], per_module: bool,
-                   make_model: ModelFactory) -> InverseModel:
-  """An untrained inverse model for the views: a column per module, or one centralised model."""
+def _inverse_model(views: list[data.View], per_module: bool, make_model: ModelFactory,
+                   params: dict) -> InverseModel:
+  """An untrained inverse model for the views: a column per module (the paper's width and
+  depth), or one centralised model configured by ``params``' model settings."""
   if per_module:
     inverse = progressive.ProgressiveLSTM()
     for view in views:
       inverse.add_column(_input_size(view), view.action_size)
     return inverse
   (view,) = views
-  return make_model(_input_size(view), view.action_size)
+  return make_model(_input_size(view), view.action_size, **hyperparameters.model_settings(params))
 
 
-def untrained(views: list[data.View], per_module: bool, make_model: ModelFactory | None
-              ) -> tuple[InverseModel, list[smpl_forward.ForwardModel]]:
-  """Untrained inverse and forward models for ``views``, to load a checkpoint into."""
+def untrained(views: list[data.View], per_module: bool, make_model: ModelFactory | None,
+              params: dict) -> tuple[InverseModel, list[smpl_forward.ForwardModel]]:
+  """Untrained inverse (configured by ``params``) and forward models for ``views``, to load a
+  checkpoint into."""
   forwards = [smpl_forward.ForwardModel(view.preceding_action_size + view.action_size,
                                         view.pose_size) for view in views]
-  return _inverse_model(views, per_module, make_model), forwards
+  return _inverse_model(views, per_module, make_model, params), forwards
 
 
 def bundle(inverse: InverseModel, forwards: list[smpl_forward.ForwardModel]) -> torch.nn.Module:
@@ -244,57 +273,106 @@ def progress_bar(label: str, epochs: int, show: bool):
 
 
 def _train(name: str, robot: robot_base.SoftArm, views: list[data.View], seed: int,
-           profile: profiles.Profile, per_module: bool, make_model: ModelFactory, show: bool
+           profile: profiles.Profile, per_module: bool, make_model: ModelFactory, params: dict,
+           show: bool
            ) -> tuple[InverseModel, list[smpl_forward.ForwardModel], list[data.Normalisation]]:
   """Collects or finds the dataset, then trains forward and inverse models (module docstring)."""
   dataset = data.collect(robot, samples=profile.samples, seed=DATA_SEED, progress=show)
-  forward_config, inverse_config = training_configs(seed, profile)
+  label = f"{name} {robot.name} seed {seed}"
+  prepared = []
+  for view in views:
+    with progress_bar(f"forward {label} {view.name}", profile.max_epochs, show) as bar:
+      prepared.append(protocols.prepare_column(robot, view, dataset,
+                                               forward_config(seed, profile),
+                                               training.default_device(), bar))
+  windows = [column.windows for column in prepared]
+  forwards = [column.forward_model for column in prepared]
+  inverse, _ = train_inverse(views, windows, forwards, seed, profile, per_module, make_model,
+                             params, label if show else None)
+  return inverse, forwards, [split.normalisation for split in windows]
+
+
+def train_inverse(views: list[data.View], windows: list[data.SplitWindows],
+                  forwards: list[smpl_forward.ForwardModel], seed: int, profile: profiles.Profile,
+                  per_module: bool, make_model: ModelFactory | None, params: dict,
+                  progress_label: str | None = None, on_epoch: EpochCallback | None = None
+                  ) -> tuple[InverseModel, float]:
+  """Trains a fresh inverse model with hyperparameters ``params`` in closed loop through the
+  frozen forward models (one per view); returns it and its validation loss.
+
+  The validation loss is the action MSE over the whole arm (normalised units, the aux term left
+  out): a baseline's best validation loss, or for SMPL the columns' best losses weighted by their
+  modules' action counts (a column's actions do not depend on the columns after it). Columns train
+  in order, the earlier ones frozen. ``on_epoch`` gets every epoch (numbered ``column *
+  profile.max_epochs + epoch``) and the validation loss so far: the trained columns' best losses
+  and the training column's latest, weighted the same way.
+  """
+  _, inverse_config = training_configs(seed, profile, params)
   device = training.default_device()
   with training.seeded(seed, torch.device("cpu")):
-    inverse = _inverse_model(views, per_module, make_model)
-  prepared = []
+    inverse = _inverse_model(views, per_module, make_model, params)
+  action_sizes = [view.action_size for view in views]
+  best_losses = []
   for index, view in enumerate(views):
-    label = f"{name} {robot.name} seed {seed} {view.name}"
-    with progress_bar(f"forward {label}", profile.max_epochs, show) as bar:
-      prepared.append(protocols.prepare_column(robot, view, dataset, forward_config, device, bar))
-    forwards = [column.forward_model for column in prepared]
-    with progress_bar(f"inverse {label}", profile.max_epochs, show) as bar:
+    label = f"inverse {progress_label} {view.name}"
+    with progress_bar(label, profile.max_epochs, progress_label is not None) as bar:
+      epoch_end = _epoch_callback(
+          bar, on_epoch, index * profile.max_epochs,
+          lambda loss: _action_weighted(best_losses + [loss], action_sizes))
       if per_module:  # Column by column, all acting together; the earlier ones stay frozen.
         inverse.columns.requires_grad_(False)
         inverse.columns[index].requires_grad_(True)
-        training.train_column_jointly(
-            inverse, forwards,
-            smpl_windows.ModuleWindows(tuple(column.windows.train for column in prepared)),
-            smpl_windows.ModuleWindows(tuple(column.windows.validation for column in prepared)),
-            inverse_config, device, bar)
+        result = training.train_column_jointly(
+            inverse, forwards[:index + 1],
+            smpl_windows.ModuleWindows(tuple(split.train for split in windows[:index + 1])),
+            smpl_windows.ModuleWindows(tuple(split.validation for split in windows[:index + 1])),
+            inverse_config, device, epoch_end)
       else:
-        training.train_inverse_model(inverse, prepared[-1].forward_model,
-                                     prepared[-1].windows.train, prepared[-1].windows.validation,
-                                     inverse_config, device, bar)
-  normalisations = [column.windows.normalisation for column in prepared]
+        result = training.train_inverse_model(inverse, forwards[index], windows[index].train,
+                                              windows[index].validation, inverse_config, device,
+                                              epoch_end)
+    best_losses.append(result.best_validation_loss)
   inverse.requires_grad_(False)
-  return inverse, forwards, normalisations
+  return inverse, _action_weighted(best_losses, action_sizes)
 
 
-def _views(robot: robot_base.SoftArm, per_module: bool) -> list[data.View]:
-  return ([data.View.module(robot, k) for k in range(1, robot.num_modules + 1)] if per_module
-          else [data.View.whole_arm(robot)])
+def _epoch_callback(bar, on_epoch: EpochCallback | None, first_epoch: int,
+                    loss_so_far: Callable[[float], float]
+                    ) -> Callable[[training.EpochReport], None]:
+  """``smpl.training.fit``'s epoch callback: advances the progress bar, then calls ``on_epoch``."""
+  def epoch_end(report: training.EpochReport) -> None:
+    if bar is not None:
+      bar(report)
+    if on_epoch is not None:
+      on_epoch(first_epoch + report.epoch, loss_so_far(report.validation_loss))
+  return epoch_end
 
 
-def _trained_config(name: str, robot: robot_base.SoftArm, views: list[data.View], seed: int,
-                    profile: profiles.Profile) -> TrainedConfig:
+def _action_weighted(losses: list[float], action_sizes: list[int]) -> float:
+  """Mean of per-view action MSEs weighted by action count: the MSE over all their actions."""
+  sizes = action_sizes[:len(losses)]
+  return sum(loss * size for loss, size in zip(losses, sizes)) / sum(sizes)
+
+
+def trained_config(name: str, robot: robot_base.SoftArm, views: list[data.View], seed: int,
+                   profile: profiles.Profile, params: dict) -> TrainedConfig:
+  """The config that names the checkpoint of agent ``name`` trained with these settings."""
   return TrainedConfig(name, robot.name, hashlib.sha256(robot.to_xml().encode()).hexdigest(),
                        tuple(view.name for view in views), profile.samples, seed,
-                       profile.max_epochs, profile.patience, profile.compile)
+                       profile.max_epochs, profile.patience, profile.compile,
+                       tuple(sorted(params.items())))
 
 
 def checkpoint_path(name: str, robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
                     per_module: bool) -> pathlib.Path:
   """Where ``build_agent`` caches the agent's checkpoint (it exists once trained)."""
-  return checkpoint_file(_trained_config(name, robot, _views(robot, per_module), seed, profile))
+  views = Learner(name, per_module).views(robot)
+  return checkpoint_file(trained_config(name, robot, views, seed, profile,
+                                        hyperparameters.values(name, robot.name)))
 
 
-def checkpoint_file(config) -> pathlib.Path:
+def checkpoint_file(config: TrainedConfig) -> pathlib.Path:
+  """The checkpoint named by ``config``."""
   return storage.softbench_home() / CHECKPOINT_FOLDER / f"{config.key}.pt"
 
 
@@ -302,18 +380,19 @@ def build_agent(name: str, robot: robot_base.SoftArm, seed: int, profile: profil
                 per_module: bool, make_model: ModelFactory | None = None,
                 show_progress: bool = False) -> LearnedAgent:
   """A trained learned agent: from the checkpoint cache, or trained now and then cached."""
-  views = _views(robot, per_module)
-  config = _trained_config(name, robot, views, seed, profile)
+  views = Learner(name, per_module, make_model).views(robot)
+  params = hyperparameters.values(name, robot.name)
+  config = trained_config(name, robot, views, seed, profile, params)
   path = checkpoint_file(config)
   if path.exists():
-    inverse, forwards = untrained(views, per_module, make_model)
+    inverse, forwards = untrained(views, per_module, make_model, params)
     arrays = checkpoint.load_checkpoint(path, bundle(inverse, forwards), config)
     normalisations = [data.Normalisation.from_arrays(
         {key.removeprefix(f"{view.name}/"): value for key, value in arrays.items()
          if key.startswith(f"{view.name}/")}) for view in views]
   else:
     inverse, forwards, normalisations = _train(name, robot, views, seed, profile, per_module,
-                                               make_model, show_progress)
+                                               make_model, params, show_progress)
     arrays = {f"{view.name}/{key}": value for view, scale in zip(views, normalisations)
               for key, value in scale.to_arrays().items()}
     checkpoint.save_checkpoint(path, bundle(inverse, forwards), config, arrays)

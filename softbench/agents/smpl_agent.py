@@ -3,7 +3,9 @@ module by module in closed loop; earlier columns are frozen when the next one tr
 
 from softbench.agents import learned
 
+LEARNER = learned.Learner("smpl", per_module=True)
+
 
 def build(robot, seed, profile, show_progress=False):
-  return learned.build_agent("smpl", robot, seed, profile, per_module=True,
-                             show_progress=show_progress)
+  return learned.build_agent(LEARNER.name, robot, seed, profile, LEARNER.per_module,
+                             LEARNER.make_model, show_progress)

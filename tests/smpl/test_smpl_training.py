@@ -239,3 +239,40 @@ def test_compiled_training_matches_eager_training(
         results[compile_] = [report.train_loss for report in result.history]
     assert not fallbacks, "torch.compile fell back to eager"
     assert results[True] == pytest.approx(results[False], rel=1e-3)
+
+
+def test_validation_leaves_out_the_aux_loss(
+    arm_data: dict[str, BabblingWindows], trained_forward_model: ForwardModel
+) -> None:
+    torch.manual_seed(0)
+    model = VAELSTMInverse(14, 2, hidden_size=16, kl_weight=10.0)  # A KL term that dominates.
+    config = InverseTrainingConfig(max_epochs=1, patience=1)
+    result = train_inverse_model(
+        model, trained_forward_model, arm_data["train"], arm_data["validation"], config, CPU
+    )
+
+    def loss(include_aux_loss: bool) -> float:
+        return evaluate_loss(
+            model,
+            lambda windows: inverse_model_loss(
+                model, trained_forward_model, windows, include_aux_loss=include_aux_loss
+            ),
+            arm_data["validation"],
+        )
+
+    assert result.best_validation_loss == loss(include_aux_loss=False)
+    assert loss(include_aux_loss=True) > result.best_validation_loss
+
+
+def test_weight_decay_shrinks_the_weights(
+    arm_data: dict[str, BabblingWindows], trained_forward_model: ForwardModel
+) -> None:
+    def weight_norm(weight_decay: float) -> float:
+        network = _fresh_column()
+        config = dataclasses.replace(SHORT_RUN, weight_decay=weight_decay)
+        train_inverse_model(
+            network, trained_forward_model, arm_data["train"], arm_data["validation"], config, CPU
+        )
+        return sum(parameter.square().sum().item() for parameter in network.parameters())
+
+    assert weight_norm(weight_decay=1.0) < weight_norm(weight_decay=0.0)

@@ -1,0 +1,21 @@
+"""Hyperparameter tuning with Optuna (``softbench tune``): the same study for every learned agent.
+
+``settings(...)`` checks a study's settings, ``run(settings)`` adds trials until the budget is
+spent and returns the study's summary, ``confirm`` trains its previous and best values at the
+profile's full epoch budget, ``write_summary`` saves it and ``adopt`` commits the best values as
+the agent's hyperparameters (``softbench.agents.hyperparameters``). See
+``softbench.tuning.study`` for the objective, sampler and pruner.
+"""
+
+from softbench.tuning.study import DEFAULT_TRIALS
+from softbench.tuning.study import TuneSettings
+from softbench.tuning.study import adopt
+from softbench.tuning.study import confirm
+from softbench.tuning.study import default_storage
+from softbench.tuning.study import run
+from softbench.tuning.study import settings
+from softbench.tuning.study import summary_path
+from softbench.tuning.study import write_summary
+
+__all__ = ["DEFAULT_TRIALS", "TuneSettings", "adopt", "confirm", "default_storage", "run", "settings",
+           "summary_path", "write_summary"]
