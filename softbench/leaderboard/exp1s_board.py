@@ -15,7 +15,6 @@ Every page (``text``, ``markdown_page``, ``html_page``) renders the same ``Table
 """
 
 import dataclasses
-import datetime
 import functools
 import importlib.resources
 import json
@@ -26,6 +25,7 @@ from softbench import continual
 from softbench import metrics
 from softbench.leaderboard import exp1s_records
 from softbench.leaderboard import records
+from softbench.leaderboard import selection
 
 PAPER_FILE = "paper_exp1s.json"  # In this package; its "source" names the paper's table.
 PAPER_METRICS = {"position_mm": "pos (mm)", "orientation_deg": "ori (deg)"}
@@ -115,10 +115,6 @@ class Group:
     return re.sub(r"[^a-z0-9]+", "-", self.title.lower()).strip("-")
 
 
-def _newest_first(entry: Entry) -> tuple:
-  return datetime.datetime.fromisoformat(entry.record["date"]), entry.path.name
-
-
 def group(loaded: list[tuple[pathlib.Path, dict]]) -> tuple[Group, ...]:
   """The Exp1S groups of checked records (``records.read_folder``); other formats are ignored."""
   by_group: dict[tuple[tuple[str, ...], str], list[Entry]] = {}
@@ -129,14 +125,8 @@ def group(loaded: list[tuple[pathlib.Path, dict]]) -> tuple[Group, ...]:
       by_group.setdefault(key, []).append(Entry(pathlib.Path(path), record))
   groups = []
   for key in sorted(by_group, key=lambda k: (len(k[0]), k)):
-    newest: dict[tuple[str, str], Entry] = {}
-    superseded = []
-    for entry in sorted(by_group[key], key=_newest_first, reverse=True):
-      if entry.setting in newest:
-        superseded.append(entry)
-      else:
-        newest[entry.setting] = entry
-    shown = sorted(newest.values(), key=lambda entry: entry.setting)
+    newest, superseded = selection.newest_per_setting(by_group[key])
+    shown = sorted(newest, key=lambda entry: entry.setting)
     groups.append(Group(*key, tuple(shown), tuple(superseded)))
   return tuple(groups)
 

@@ -149,16 +149,20 @@ def _table(group: ranking.Group, out: pathlib.Path) -> str:
           f'<tbody>{"".join(body)}</tbody></table>')
 
 
+def _superseded(entries, setting: str, out: pathlib.Path) -> str:
+  """The note listing records superseded by a newer one of the same ``setting``."""
+  items = "".join(f'<li><a href="{_e(links.record(entry, out))}">{_e(entry.path.name)}</a> '
+                  f"({_e(entry.label)}, {_e(entry.record['date'])})</li>" for entry in entries)
+  return (f'<p class="note">Superseded by a newer record of the same {_e(setting)}:</p>'
+          f'<ul class="note">{items}</ul>')
+
+
 def _group(group: ranking.Group, out: pathlib.Path) -> str:
   parts = [f'<section id="{_e(group.anchor)}"><h2>{_e(group.title)}</h2>', _table(group, out),
            '<div class="charts">' + "".join(_chart(group, name) for name in group.metrics) +
            "</div>"]
   if group.superseded:
-    items = "".join(f'<li><a href="{_e(links.record(entry, out))}">{_e(entry.path.name)}</a> '
-                    f"({_e(entry.label)}, {_e(entry.record['date'])})</li>"
-                    for entry in group.superseded)
-    parts.append('<p class="note">Superseded by a newer record of the same agent, profile and '
-                 f"eval mode:</p><ul class=\"note\">{items}</ul>")
+    parts.append(_superseded(group.superseded, "agent, profile and eval mode", out))
   parts.append("</section>")
   return "\n".join(parts)
 
@@ -214,11 +218,7 @@ def _exp1s_group(group: exp1s_board.Group, out: pathlib.Path) -> str:
     parts += [_exp1s_table(table) for table in exp1s_board.score_tables(entry)]
     parts.append(_heat_map(entry))
   if group.superseded:
-    items = "".join(f'<li><a href="{_e(links.record(entry, out))}">{_e(entry.path.name)}</a> '
-                    f"({_e(entry.label)}, {_e(entry.record['date'])})</li>"
-                    for entry in group.superseded)
-    parts.append('<p class="note">Superseded by a newer record of the same agent and profile:'
-                 f"</p><ul class=\"note\">{items}</ul>")
+    parts.append(_superseded(group.superseded, "agent and profile", out))
   parts += [f'<p class="note">{_e(exp1s_board.about_paper())}</p>', "</section>"]
   return "\n".join(parts)
 

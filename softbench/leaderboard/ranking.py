@@ -21,6 +21,7 @@ import numpy as np
 
 from softbench import suite
 from softbench.leaderboard import exp1s_board
+from softbench.leaderboard import selection
 from softbench.leaderboard import records
 
 CONFIDENCE = 0.95
@@ -134,8 +135,6 @@ def _moment(record: dict) -> datetime.datetime:
   return datetime.datetime.fromisoformat(record["date"])  # Checked, with a time zone.
 
 
-def _newest_first(entry: Entry) -> tuple:
-  return _moment(entry.record), entry.path.name
 
 
 def rank(loaded: list[tuple[pathlib.Path, dict]]) -> Leaderboard:
@@ -147,14 +146,8 @@ def rank(loaded: list[tuple[pathlib.Path, dict]]) -> Leaderboard:
       by_group.setdefault(_group_key(record), []).append(Entry.of(path, record))
   groups = []
   for key in sorted(by_group, key=lambda k: (_robot_order(k[0]), suite.TASKS.index(k[1]), k[2])):
-    newest: dict[tuple[str, str, str], Entry] = {}
-    superseded = []
-    for entry in sorted(by_group[key], key=_newest_first, reverse=True):
-      if entry.setting in newest:
-        superseded.append(entry)
-      else:
-        newest[entry.setting] = entry
-    ranked = sorted(newest.values(),
+    shown, superseded = selection.newest_per_setting(by_group[key])
+    ranked = sorted(shown,
                     key=lambda entry: (entry.estimates[RANKED_BY].mean, entry.setting))
     groups.append(Group(*key, tuple(ranked), tuple(superseded)))
   latest = max((record for _, record in loaded), key=_moment, default=None)
