@@ -202,6 +202,10 @@ def test_softbench_run_adaptive_end_to_end(tmp_path, capsys):
     (["--task", "reach", "--agent", "smpl", "--adaptive", "--helpers", "push"],
      "unknown helpers"),
     (["--task", "circle", "--agent", "smpl", "--module", "2"], "--module goes with --task reach"),
+    (["--task", "reach", "--agent", "smpl", "--adaptive", "--fault", "2:0:0"],
+     "--fault and --adaptive"),
+    (["--task", "reach", "--agent", "smpl", "--adaptive", "--video", "reach.mp4"],
+     "--adaptive draws its own figure"),
 ])
 def test_run_adaptive_refuses_bad_input_with_one_line(argv, message, capsys, tmp_path):
   assert cli.main(["run", *argv, "--profile", "tiny", "--results", str(tmp_path)]) == \

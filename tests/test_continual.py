@@ -79,3 +79,11 @@ def test_unknown_protocol_and_missing_task(capsys):
   assert cli.main(["run", "--agent", "smpl"]) == cli.EXIT_USAGE
   lines = capsys.readouterr().err.strip().splitlines()
   assert "unknown protocol" in lines[0] and "needs --task" in lines[1]
+
+
+@pytest.mark.parametrize("extra", [["--video", "x.mp4"], ["--fault", "1:0:0.5"], ["--adaptive"]])
+def test_exp1s_refuses_per_run_options(extra, capsys, tmp_path):
+  argv = ["run", "--protocol", "exp1s", "--agent", "smpl", *extra, "--results", str(tmp_path)]
+  assert cli.main(argv) == cli.EXIT_USAGE
+  lines = capsys.readouterr().err.strip().splitlines()
+  assert len(lines) == 1 and f"drop {extra[0]}" in lines[0]
