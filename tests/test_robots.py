@@ -346,6 +346,35 @@ def test_cable_and_joint_backbones_agree(robot_name):
   assert worst < BACKBONE_TOLERANCE, f"backbones disagree by {worst:.2%} of the length"
 
 
+# 7b. Discretisation: refining the chain must not change the module's material.
+
+
+def _module_series_compliance(model: mujoco.MjModel, module: int, kind: str) -> float:
+  """Sum of 1 / stiffness over a module's joints of ``kind`` ("slide" or "ball"): the compliance
+  of those springs in series; 0 when the module has none or they carry no stiffness."""
+  names = [model.joint(j).name for j in range(model.njnt)]
+  stiffness = [model.jnt_stiffness[j] for j, name in enumerate(names)
+               if name.startswith(f"module{module}_segment") and name.endswith(f"_{kind}")]
+  return float(sum(1.0 / k for k in stiffness if k > 0))
+
+
+@pytest.mark.parametrize("robot_name", _robots())
+@pytest.mark.parametrize("factor", [2, 3])
+def test_refining_keeps_every_module_material(robot_name, factor):
+  # Springs per joint that do not scale with the segment count soften a module as it is refined;
+  # the pneumatic arm's slide joints did, and its discretisation error was 7.1 % of the length
+  # instead of 0.43 %.
+  robot = make(robot_name)
+  coarse, fine = robot.compile(), robot.refined(factor).compile()
+  # Segments straddle module boundaries (the rod is staggered), so mass is compared as a whole;
+  # the exported XML keeps 6 significant digits.
+  assert robot.mass(fine) == pytest.approx(robot.mass(coarse), rel=1e-5)
+  for module in range(1, robot.num_modules + 1):
+    for kind in ("slide", "ball"):
+      assert _module_series_compliance(fine, module, kind) == pytest.approx(
+          _module_series_compliance(coarse, module, kind), rel=1e-5), (module, kind)
+
+
 # 8. Exported XML.
 
 

@@ -54,8 +54,11 @@ class PneumaticArm(base.SoftArm):
     backbone_radius: Radius of the backbone cylinders (m), which carry the module mass.
     backbone_bending_stiffness: E·I of the backbone (N·m²): the plates' resistance to bending and
       twist beyond what the bellows give.
-    backbone_axial_stiffness: Axial stiffness of each backbone slide joint (N/m).
-    backbone_axial_damping: Damping of each backbone slide joint (N·s/m).
+    backbone_axial_stiffness: Axial stiffness of one module's backbone (N/m). Its
+      ``segments_per_module`` slide joints act in series, so each gets this times their count,
+      and the module's stiffness does not depend on the discretisation.
+    backbone_axial_damping: Axial damping of one module's backbone (N·s/m), shared among its
+      slide joints in series the same way.
     joint_damping: Damping of the backbone's ball joints (N·m·s/rad).
     armature: Added inertia of every joint DOF (kg·m² or kg).
     timestep: Physics time step (s).
@@ -74,8 +77,8 @@ class PneumaticArm(base.SoftArm):
   segments_per_module: int = 4
   backbone_radius: float = 0.008
   backbone_bending_stiffness: float = 0.02
-  backbone_axial_stiffness: float = 50.0
-  backbone_axial_damping: float = 2.0
+  backbone_axial_stiffness: float = 12.5
+  backbone_axial_damping: float = 0.5
   joint_damping: float = 0.05
   armature: float = 1.0e-5
   timestep: float = 1.0e-3
@@ -156,8 +159,9 @@ class PneumaticArm(base.SoftArm):
                                    self.backbone_radius, self.module_mass / volume)
     joints = chain.SegmentJoints(
         bending_stiffness=self.backbone_bending_stiffness, ball_damping=self.joint_damping,
-        armature=self.armature, slide_stiffness=self.backbone_axial_stiffness,
-        slide_damping=self.backbone_axial_damping)
+        armature=self.armature,
+        slide_stiffness=self.backbone_axial_stiffness * self.segments_per_module,
+        slide_damping=self.backbone_axial_damping * self.segments_per_module)
     base_body = spec.worldbody.add_body(name="base")
     base_body.add_geom(name="base_plate", type=mujoco.mjtGeom.mjGEOM_CYLINDER,
                        size=(self.bellows_offset + self.bellows_radius, 0.003, 0),
