@@ -9,6 +9,7 @@ below the diagonal: later stages leave earlier columns' outputs bit-identical.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 from collections.abc import Callable, Sequence
@@ -122,17 +123,29 @@ def evaluate_columns(
     ]
 
 
+EpochCallback = Callable[[EpochReport], None]
+StageProgress = Callable[[int], contextlib.AbstractContextManager[EpochCallback | None]]
+"""Given a stage, a context entered around that stage's training that yields the callback its
+epochs report to (a progress bar), or None."""
+
+
+def no_stage_progress(stage: int) -> contextlib.AbstractContextManager[None]:
+    return contextlib.nullcontext(None)
+
+
 def train_progressively(
     network: ProgressiveLSTM,
     tasks: Sequence[ColumnTask],
     config: InverseTrainingConfig = InverseTrainingConfig(),
     device: torch.device | None = None,
+    stage_progress: StageProgress = no_stage_progress,
 ) -> ProgressiveRun:
     """Trains one new column per task in order, scoring all columns so far after each stage."""
     first_new_column = network.num_columns
     run = ProgressiveRun(training=[], scores=[])
     for stage, task in enumerate(tasks):
-        run.training.append(train_next_column(network, task, config, device))
+        with stage_progress(stage) as on_epoch_end:
+            run.training.append(train_next_column(network, task, config, device, on_epoch_end))
         seen = list(enumerate(tasks[: stage + 1], start=first_new_column))
         run.scores.append(evaluate_columns(network, seen))
     return run

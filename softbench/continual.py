@@ -97,22 +97,14 @@ def _params() -> dict:
 def _train(seed: int, profile: profiles.Profile, show: bool):
   """Column by column over the configurations; returns network, forwards, normalisations, run."""
   forward_config, inverse_config = learned.training_configs(seed, profile, _params())
-  device = training.default_device()
-  network = progressive.ProgressiveLSTM()
-  prepared, outcome = [], smpl_protocol.ProgressiveRun(training=[], scores=[])
-  for arm, view in protocols.get(PROTOCOL).column_views():
-    dataset = data.collect(arm, samples=profile.samples, seed=learned.DATA_SEED, progress=show)
-    label = f"{PROTOCOL} seed {seed} {arm.name}"
-    with learned.progress_bar(f"forward {label}", profile.max_epochs, show) as bar:
-      prepared.append(protocols.prepare_column(arm, view, dataset, forward_config, device, bar))
-    with learned.progress_bar(f"inverse {label}", profile.max_epochs, show) as bar:
-      outcome.training.append(smpl_protocol.train_next_column(
-          network, prepared[-1].task, inverse_config, device, bar))
-    outcome.scores.append(smpl_protocol.evaluate_columns(
-        network, list(enumerate(column.task for column in prepared))))
-  network.requires_grad_(False)
-  return (network, [column.forward_model for column in prepared],
-          [column.windows.normalisation for column in prepared], outcome)
+  progress_bars = lambda label: learned.progress_bar(f"{label} ({PROTOCOL} seed {seed})",
+                                                     profile.max_epochs, show)
+  result = protocols.run(protocols.get(PROTOCOL), profile.samples, learned.DATA_SEED,
+                         forward_config, inverse_config, training.default_device(), show,
+                         progress_bars)
+  result.network.requires_grad_(False)
+  return (result.network, [column.forward_model for column in result.columns],
+          [column.windows.normalisation for column in result.columns], result.run)
 
 
 def _matrices(outcome: smpl_protocol.ProgressiveRun) -> dict[str, np.ndarray]:
@@ -178,7 +170,7 @@ def run_seed(seed: int, profile: profiles.Profile, show_progress: bool = False) 
     for loop, error_source in LOOPS.items():
       agent.error_source = error_source
       for task in TASKS:
-        env = suite.load(arm, task, seed=seed, **task_options(profile))
+        env = suite.load(arm, task, seed=seed, **profile.episode_options(task))
         episode = evaluation.run_episode(env, agent, task, show_progress)
         scores[loop][task].append(_end_effector_scores(episode, arm.length))
   tip = [entry["normalised_tip_percent"] for entry in scores["closed"][FORGETTING_TASK]]
@@ -188,10 +180,6 @@ def run_seed(seed: int, profile: profiles.Profile, show_progress: bool = False) 
                  for row in model.forgetting_pose_mse]
   return {"seed": seed, "scores": scores, "forgetting_model_pose_mse": model_level,
           "forgetting_tip_percent": physics}
-
-
-def task_options(profile: profiles.Profile) -> dict:
-  return {} if profile.episode_length is None else {"length": profile.episode_length}
 
 
 RECORD_FORMAT = "softbench-exp1s-result"

@@ -20,6 +20,13 @@ class Profile:
   compile: bool  # torch.compile the training step (smpl.training.TrainingConfig.compile).
   episode_length: int | None = None  # Tracking targets per episode; None: the task's default.
 
+  def episode_options(self, task: str) -> dict:
+    """The ``suite.load`` option that sets ``task``'s episode length to the profile's, if any
+    (``reach`` counts control steps, the tracking tasks targets)."""
+    if self.episode_length is None:
+      return {}
+    return {"steps" if task == "reach" else "length": self.episode_length}
+
 
 PROFILES = {
     "paper": Profile("paper", samples=14_000, max_epochs=800, patience=50, seeds=5, compile=True),

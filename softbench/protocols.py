@@ -13,6 +13,7 @@ alone (``smpl.protocol.train_progressively``); in Exp2S/Exp2R the columns act to
 on module k's own inputs (``smpl.training.train_column_jointly``), as the ``smpl`` agent does.
 """
 
+import contextlib
 import dataclasses
 from collections.abc import Callable
 
@@ -99,27 +100,47 @@ class ProtocolResult:
   run: smpl_protocol.ProgressiveRun
 
 
+ProgressBars = Callable[[str], contextlib.AbstractContextManager[
+    Callable[[training.EpochReport], None] | None]]
+"""Given a label (``forward tendon-2 end-effector``), a context entered around that model's
+training that yields the callback its epochs report to (a progress bar), or None."""
+
+
+def no_progress_bars(label: str) -> contextlib.AbstractContextManager[None]:
+  return contextlib.nullcontext(None)
+
+
 def run(protocol: Protocol, samples: int = data.DEFAULT_SAMPLES, seed: int = 0,
         forward_config: training.ForwardTrainingConfig = training.ForwardTrainingConfig(),
         inverse_config: training.InverseTrainingConfig = training.InverseTrainingConfig(),
-        device: torch.device | None = None, progress: bool = True) -> ProtocolResult:
-  """Collects (or finds) each robot's dataset, prepares every column, then trains the
-  progressive network column by column (``smpl.protocol.train_progressively``)."""
-  datasets = {name: data.collect(name, samples=samples, seed=seed, progress=progress)
-              for name in protocol.robot_names}
-  columns = [prepare_column(arm, view, datasets[arm.name], forward_config, device)
-             for arm, view in protocol.column_views()]
+        device: torch.device | None = None, progress: bool = True,
+        progress_bars: ProgressBars = no_progress_bars) -> ProtocolResult:
+  """Collects (or finds) each robot's dataset (babbling seed ``seed``), prepares every column,
+  then trains the progressive network column by column (``smpl.protocol.train_progressively``,
+  or all columns acting together for a per-module protocol). The configs' seeds fix the weights.
+  """
+  column_views = protocol.column_views()
+  labels = [f"{arm.name} {view.name}" for arm, view in column_views]
+  datasets, columns = {}, []
+  for (arm, view), label in zip(column_views, labels):
+    if arm.name not in datasets:
+      datasets[arm.name] = data.collect(arm, samples=samples, seed=seed, progress=progress)
+    with progress_bars(f"forward {label}") as on_epoch_end:
+      columns.append(prepare_column(arm, view, datasets[arm.name], forward_config, device,
+                                    on_epoch_end))
+  stage_bars = lambda stage: progress_bars(f"inverse {labels[stage]}")
   network = progressive.ProgressiveLSTM()
   if protocol.per_module:
-    outcome = _train_jointly(network, columns, inverse_config, device)
+    outcome = _train_jointly(network, columns, inverse_config, device, stage_bars)
   else:
     outcome = smpl_protocol.train_progressively(network, [column.task for column in columns],
-                                                inverse_config, device)
+                                                inverse_config, device, stage_bars)
   return ProtocolResult(protocol, network, columns, outcome)
 
 
 def _train_jointly(network: progressive.ProgressiveLSTM, columns: list[PreparedColumn],
-                   config: training.InverseTrainingConfig, device: torch.device | None
+                   config: training.InverseTrainingConfig, device: torch.device | None,
+                   stage_progress: smpl_protocol.StageProgress
                    ) -> smpl_protocol.ProgressiveRun:
   """Adds and trains one column per module, all columns acting together; scores after each."""
   device = device if device is not None else training.default_device()
@@ -132,8 +153,9 @@ def _train_jointly(network: progressive.ProgressiveLSTM, columns: list[PreparedC
       network.add_column(smpl_windows.inverse_input_size(train.pose_size, train.action_size),
                          train.action_size)
     forwards = [c.forward_model for c in seen]
-    outcome.training.append(training.train_column_jointly(
-        network, forwards, split("train"), split("validation"), config, device))
+    with stage_progress(stage) as on_epoch_end:
+      outcome.training.append(training.train_column_jointly(
+          network, forwards, split("train"), split("validation"), config, device, on_epoch_end))
     test = split("test").to(device)
     with torch.no_grad(), training.limited_cpu_threads(config.cpu_threads, device):
       rollouts = smpl_rollout.joint_rollout(network.eval(), test, forwards)

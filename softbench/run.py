@@ -133,9 +133,7 @@ def task_options(run: RunSettings) -> dict:
   if run.task == "custom":
     return {"trajectory": run.trajectory}
   options = {} if run.module is None else {"module": run.module}
-  if run.profile.episode_length is None:
-    return options
-  return {**options, "steps" if run.task == "reach" else "length": run.profile.episode_length}
+  return {**options, **run.profile.episode_options(run.task)}
 
 
 def _seed_scores(score: metrics.TrackingScore) -> dict:

@@ -1,5 +1,7 @@
 """The SMPL protocols wired to real babbling data, on tiny robots, datasets and budgets."""
 
+import contextlib
+
 import numpy as np
 import pytest
 import torch
@@ -50,3 +52,22 @@ def test_protocol_trains_a_column_per_stage_and_never_forgets(protocol):
   for index, (column, (arm, view)) in enumerate(zip(result.columns, protocol.column_views())):
     assert result.network.columns[index].output_size == view.action_size
     assert column.windows.train.pose_size == view.pose_size
+
+
+def test_protocol_reports_every_epoch_of_every_model_to_its_progress_bar():
+  protocol = protocols.Protocol("continual", ("tendon-1", "tendon-2"), False, "Exp1S in small")
+  epochs = {}
+
+  @contextlib.contextmanager
+  def progress_bars(label):
+    epochs[label] = []
+    yield lambda report: epochs[label].append(report.epoch)
+
+  result = protocols.run(protocol, samples=SAMPLES, forward_config=TINY_FORWARD,
+                         inverse_config=TINY_INVERSE, device=torch.device("cpu"),
+                         progress=False, progress_bars=progress_bars)
+  assert list(epochs) == ["forward tendon-1 end-effector", "forward tendon-2 end-effector",
+                          "inverse tendon-1 end-effector", "inverse tendon-2 end-effector"]
+  trained = [column.forward_training for column in result.columns] + result.run.training
+  for label, training_result in zip(epochs, trained):
+    assert epochs[label] == [report.epoch for report in training_result.history], label
