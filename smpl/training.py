@@ -14,6 +14,8 @@ makes every inverse model's validation loss the same quantity.
 
 from __future__ import annotations
 
+import dataclasses
+import hashlib
 import math
 import time
 import warnings
@@ -24,6 +26,7 @@ from dataclasses import dataclass, field
 import torch
 from torch import Tensor, nn
 
+from smpl import snapshots
 from smpl.forward_model import ForwardModel
 from smpl.inverse import InverseModel
 from smpl.progressive import ProgressiveLSTM
@@ -176,10 +179,12 @@ def fit(
     """Trains the trainable parameters of `model` to minimise `batch_loss` on `train`.
 
     Each epoch shuffles the training windows, takes one Adam step per batch, then scores the whole
-    validation set with `validation_loss` (default: `batch_loss`). Training stops after `config.max_epochs` or when the validation loss has not
-    improved for `config.patience` epochs; the model ends with the weights of its best epoch, in
-    eval mode. The same config and data give the same weights. `batch_loss` must use tensors on
-    the model's device: `fit` moves `model` and the windows there, nothing else.
+    validation set with `validation_loss` (default: `batch_loss`). Training stops after
+    `config.max_epochs` or when the validation loss has not improved for `config.patience` epochs;
+    the model ends with the weights of its best epoch, in eval mode. The same config and data give
+    the same weights. `batch_loss` must use tensors on the model's device: `fit` moves `model` and
+    the windows there, nothing else. Inside `smpl.snapshots.resumable`, a stopped fit resumes
+    where it was (`on_epoch_end` then first gets the epochs already run).
     """
     device = device if device is not None else default_device()
     parameters = [parameter for parameter in model.parameters() if parameter.requires_grad]
@@ -188,6 +193,8 @@ def fit(
     model.to(device)
     train = train.to(device)
     validation = validation.to(device)
+    snapshot = snapshots.next_path()
+    fingerprint = _fingerprint(model, train, validation, config) if snapshot else ""
     with seeded(config.seed, device), limited_cpu_threads(config.cpu_threads, device):
         optimizer = torch.optim.Adam(
             parameters, lr=config.learning_rate, weight_decay=config.weight_decay
@@ -195,36 +202,118 @@ def fit(
         train_loss_of, step = batch_loss, optimizer.step
         if config.compile:
             train_loss_of, step = _compiled(batch_loss), _compiled(optimizer.step)
-        shuffling = torch.Generator().manual_seed(config.seed)
-        stopping = EarlyStopping(config.patience)
-        best_state = _copy_state(model)
-        history = []
-        for epoch in range(config.max_epochs):
+        run = _FitState(
+            model,
+            optimizer,
+            torch.Generator().manual_seed(config.seed),
+            EarlyStopping(config.patience),
+            device,
+        )
+        saved = snapshots.load(snapshot, fingerprint) if snapshot else None
+        if saved is not None:
+            run.restore(saved)
+            for report in run.history if on_epoch_end is not None else ():
+                on_epoch_end(report)
+        last_saved = time.monotonic()
+        while not run.finished and len(run.history) < config.max_epochs:
             started = time.perf_counter()
             model.train()
             train_loss = _train_epoch(
-                train_loss_of, step, optimizer, train, config.batch_size, shuffling
+                train_loss_of, step, optimizer, train, config.batch_size, run.shuffling
             )
             epoch_validation_loss = evaluate_loss(model, validation_loss or batch_loss, validation)
-            improved = stopping.update(epoch, epoch_validation_loss)
-            if improved:
-                best_state = _copy_state(model)
-            report = EpochReport(
-                epoch,
-                train_loss,
-                epoch_validation_loss,
-                stopping.best_loss,
-                improved,
-                time.perf_counter() - started,
-            )
-            history.append(report)
+            report = run.record(train_loss, epoch_validation_loss, time.perf_counter() - started)
+            if snapshot and time.monotonic() - last_saved >= snapshots.SAVE_INTERVAL_S:
+                snapshots.save(snapshot, fingerprint, run.state())
+                last_saved = time.monotonic()
             if on_epoch_end is not None:
                 on_epoch_end(report)
-            if stopping.should_stop:
-                break
-        model.load_state_dict(best_state)
+        run.finished = True
+        if snapshot:
+            snapshots.save(snapshot, fingerprint, run.state())
+        model.load_state_dict(run.best_state)
         model.eval()
-    return TrainingResult(stopping.best_epoch, stopping.best_loss, stopping.should_stop, history)
+    stopping = run.stopping
+    return TrainingResult(
+        stopping.best_epoch, stopping.best_loss, stopping.should_stop, run.history
+    )
+
+
+class _FitState:
+    """Everything a `fit` carries from one epoch to the next, which a snapshot saves."""
+
+    def __init__(
+        self,
+        model: nn.Module,
+        optimizer: torch.optim.Optimizer,
+        shuffling: torch.Generator,
+        stopping: EarlyStopping,
+        device: torch.device,
+    ) -> None:
+        self.model = model
+        self.optimizer = optimizer
+        self.shuffling = shuffling
+        self.stopping = stopping
+        self.device = device
+        self.best_state = _copy_state(model)
+        self.history: list[EpochReport] = []
+        self.finished = False
+
+    def record(self, train_loss: float, validation_loss: float, seconds: float) -> EpochReport:
+        """Scores the epoch just trained; keeps the weights if they are the best so far."""
+        epoch = len(self.history)
+        improved = self.stopping.update(epoch, validation_loss)
+        if improved:
+            self.best_state = _copy_state(self.model)
+        report = EpochReport(epoch, train_loss, validation_loss, self.stopping.best_loss,
+                             improved, seconds)
+        self.history.append(report)
+        self.finished = self.stopping.should_stop
+        return report
+
+    def state(self) -> dict:
+        """The state to save: weights, optimiser, best weights, early stopping, history, and the
+        generators that shuffle batches and draw the model's noise."""
+        return {
+            "model": _copy_state(self.model),
+            "optimizer": self.optimizer.state_dict(),
+            "best": self.best_state,
+            "stopping": [self.stopping.best_loss, self.stopping.best_epoch,
+                         self.stopping.epochs_without_improvement],
+            "history": [dataclasses.asdict(report) for report in self.history],
+            "shuffling": self.shuffling.get_state(),
+            "rng": torch.get_rng_state(),
+            "accelerator_rng": (torch.cuda.get_rng_state(self.device)
+                                if self.device.type == "cuda" else torch.zeros(0)),
+            "finished": self.finished,
+        }
+
+    def restore(self, state: dict) -> None:
+        self.model.load_state_dict(state["model"])
+        self.optimizer.load_state_dict(state["optimizer"])
+        self.best_state = {name: tensor.to(self.device) for name, tensor in state["best"].items()}
+        (self.stopping.best_loss, self.stopping.best_epoch,
+         self.stopping.epochs_without_improvement) = state["stopping"]
+        self.history = [EpochReport(**report) for report in state["history"]]
+        self.shuffling.set_state(state["shuffling"])
+        torch.set_rng_state(state["rng"])
+        if self.device.type == "cuda":
+            torch.cuda.set_rng_state(state["accelerator_rng"], self.device)
+        self.finished = state["finished"]
+
+
+def _fingerprint(
+    model: nn.Module, train: BabblingWindows, validation: BabblingWindows, config: TrainingConfig
+) -> str:
+    """What a snapshot must match to be resumed: the config, the data and the initial weights."""
+    digest = hashlib.sha256(repr(config).encode())
+    for windows in (train, validation):
+        for tensor in windows.tensors():
+            digest.update(tensor.detach().cpu().contiguous().numpy().tobytes())
+    for name, tensor in model.state_dict().items():
+        digest.update(name.encode())
+        digest.update(tensor.detach().cpu().contiguous().numpy().tobytes())
+    return digest.hexdigest()
 
 
 def evaluate_loss(model: nn.Module, batch_loss: BatchLoss, windows: BabblingWindows) -> float:

@@ -159,13 +159,18 @@ class BabblingWindows:
             self.poses.to(device), self.actions.to(device), self.preceding_actions.to(device)
         )
 
+    def tensors(self) -> tuple[Tensor, ...]:
+        """Every tensor of the windows (to fingerprint the data)."""
+        return self.poses, self.actions, self.preceding_actions
+
 
 @dataclass(frozen=True)
 class ModuleWindows:
     """Time-aligned windows of every module of one arm (window i of each module covers the same
     control steps), for training a distributed controller's columns together.
 
-    It offers what `smpl.training.fit` uses of BabblingWindows: `len`, `subset`, `to`, `actions`.
+    It offers what `smpl.training.fit` uses of BabblingWindows: `len`, `subset`, `to`, `actions`,
+    `tensors`.
     """
 
     modules: tuple[BabblingWindows, ...]
@@ -188,3 +193,6 @@ class ModuleWindows:
 
     def to(self, device: torch.device) -> ModuleWindows:
         return ModuleWindows(tuple(windows.to(device) for windows in self.modules))
+
+    def tensors(self) -> tuple[Tensor, ...]:
+        return tuple(tensor for windows in self.modules for tensor in windows.tensors())

@@ -25,6 +25,7 @@ import numpy as np
 from smpl import checkpoint
 from smpl import progressive
 from smpl import protocol as smpl_protocol
+from smpl import snapshots
 from smpl import training
 from softbench import data
 from softbench import evaluation
@@ -128,11 +129,13 @@ def build(seed: int, profile: profiles.Profile, show_progress: bool = False) -> 
     matrices = {key: np.asarray(value) for key, value in arrays.items()
                 if key.startswith("forgetting/")}
   else:
-    network, forwards, normalisations, outcome = _train(seed, profile, show_progress)
+    with snapshots.resumable(learned.snapshot_folder(path)):
+      network, forwards, normalisations, outcome = _train(seed, profile, show_progress)
     matrices = _matrices(outcome)
     arrays = {f"{arm.name}/{key}": value for arm, scale in zip(arms, normalisations)
               for key, value in scale.to_arrays().items()}
     checkpoint.save_checkpoint(path, learned.bundle(network, forwards), config, {**arrays, **matrices})
+    snapshots.discard(learned.snapshot_folder(path))
   network.eval()
   controllers = [learned.Controller(view, forward.eval(), scale)
                  for view, forward, scale in zip(views, forwards, normalisations)]

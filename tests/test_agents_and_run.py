@@ -5,7 +5,10 @@ import pathlib
 
 import numpy as np
 import pytest
+import torch
 
+from smpl import snapshots
+from smpl import training
 from softbench import agents
 from softbench import cli
 from softbench import evaluation
@@ -54,6 +57,38 @@ def test_checkpoint_round_trip_gives_identical_actions(agent_name, tmp_path, mon
   checkpoint.write_bytes(checkpoint.read_bytes()[:1000])
   with pytest.raises(ValueError, match="not a readable checkpoint"):
     agents.make(agent_name, "tendon-2", 0, "tiny")
+
+
+@pytest.mark.parametrize("agent_name", [name for name in agents.AGENTS
+                                        if agents.describe(name).learned])
+def test_interrupted_training_resumes_to_the_same_checkpoint(agent_name, tmp_path, monkeypatch):
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
+  monkeypatch.setattr(snapshots, "SAVE_INTERVAL_S", 0.0)
+  agents.make(agent_name, "tendon-2", 0, "tiny")
+  (checkpoint,) = (tmp_path / learned.CHECKPOINT_FOLDER).glob(f"{agent_name}-*.pt")
+  uninterrupted = torch.load(checkpoint, weights_only=False)["state_dict"]
+  checkpoint.unlink()
+  epochs, train_epoch = 0, training._train_epoch
+
+  def interrupted_in_the_fourth_epoch(*args):
+    # Every agent has run at least one whole fit by then, and one epoch of the fit under way.
+    nonlocal epochs
+    epochs += 1
+    if epochs == 4:
+      raise KeyboardInterrupt
+    return train_epoch(*args)
+
+  monkeypatch.setattr(training, "_train_epoch", interrupted_in_the_fourth_epoch)
+  with pytest.raises(KeyboardInterrupt):
+    agents.make(agent_name, "tendon-2", 0, "tiny")
+  folder = learned.snapshot_folder(checkpoint)
+  assert sorted(path.name for path in folder.iterdir())[:2] == ["fit-1.pt", "fit-2.pt"]
+  monkeypatch.setattr(training, "_train_epoch", train_epoch)
+  agents.make(agent_name, "tendon-2", 0, "tiny")
+  resumed = torch.load(checkpoint, weights_only=False)["state_dict"]
+  assert resumed.keys() == uninterrupted.keys()
+  assert all(torch.equal(resumed[key], uninterrupted[key]) for key in resumed)
+  assert not folder.exists()
 
 
 @pytest.mark.parametrize("mode", learned.ERROR_SOURCES)

@@ -6,7 +6,8 @@ inverse model in closed loop through it (``smpl.training``), seeded by the agent
 one progressive column per module (``View.module``, trained in order, earlier columns frozen);
 the baselines are one centralised model over the whole arm (``View.whole_arm``). Each agent
 trains with its committed hyperparameters (``softbench.agents.hyperparameters``), which enter the
-checkpoint's config, so a change of values never reuses a stale checkpoint.
+checkpoint's config, so a change of values never reuses a stale checkpoint. An interrupted training
+resumes from its snapshots (``smpl.snapshots``, in ``snapshot_folder``) to the same weights.
 
 Acting, at control step t, each controller reads (normalised with its training statistics)
 
@@ -43,6 +44,7 @@ from smpl import checkpoint
 from smpl import forward_model as smpl_forward
 from smpl import progress
 from smpl import progressive
+from smpl import snapshots
 from smpl import training
 from smpl import windows as smpl_windows
 from smpl.inverse import InverseModel
@@ -376,6 +378,12 @@ def checkpoint_file(config: TrainedConfig) -> pathlib.Path:
   return storage.softbench_home() / CHECKPOINT_FOLDER / f"{config.key}.pt"
 
 
+def snapshot_folder(checkpoint_path: pathlib.Path) -> pathlib.Path:
+  """Where the training of a checkpoint keeps its snapshots until the checkpoint is written, so
+  that an interrupted training resumes (``smpl.snapshots``)."""
+  return checkpoint_path.with_suffix(".partial")
+
+
 def build_agent(name: str, robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
                 per_module: bool, make_model: ModelFactory | None = None,
                 show_progress: bool = False) -> LearnedAgent:
@@ -391,11 +399,13 @@ def build_agent(name: str, robot: robot_base.SoftArm, seed: int, profile: profil
         {key.removeprefix(f"{view.name}/"): value for key, value in arrays.items()
          if key.startswith(f"{view.name}/")}) for view in views]
   else:
-    inverse, forwards, normalisations = _train(name, robot, views, seed, profile, per_module,
-                                               make_model, params, show_progress)
+    with snapshots.resumable(snapshot_folder(path)):
+      inverse, forwards, normalisations = _train(name, robot, views, seed, profile, per_module,
+                                                 make_model, params, show_progress)
     arrays = {f"{view.name}/{key}": value for view, scale in zip(views, normalisations)
               for key, value in scale.to_arrays().items()}
     checkpoint.save_checkpoint(path, bundle(inverse, forwards), config, arrays)
+    snapshots.discard(snapshot_folder(path))
   inverse.eval()
   controllers = [Controller(view, forward.eval(), scale)
                  for view, forward, scale in zip(views, forwards, normalisations)]

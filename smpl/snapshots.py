@@ -1,0 +1,105 @@
+"""Resumable training: `smpl.training.fit` keeps its state in a snapshot file and resumes from it.
+
+Inside `with resumable(folder):` the n-th call of `fit` keeps its state in `folder/fit-<n>.pt`,
+saved atomically at most every `SAVE_INTERVAL_S` seconds and when it ends. A training run calls
+`fit` in the same order every time (forward models, then inverse columns), so after an
+interruption each call finds its own snapshot again: a fit that had finished returns its result
+at once, one that was under way goes on from its last saved epoch and ends with the same weights,
+to the bit, as if it had never stopped. A snapshot that does not match its call (another config,
+other data, other initial weights) or cannot be read is ignored, with a warning, and that fit
+starts over. Outside `resumable`, `fit` keeps no snapshots.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import contextvars
+import os
+import pickle
+import shutil
+import tempfile
+import warnings
+import zipfile
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import torch
+
+SAVE_INTERVAL_S = 30.0
+"""Least wall time (s) between two snapshots of a fit under way."""
+_FORMAT = "softbench-smpl-fit-snapshot"
+_UNREADABLE = (RuntimeError, EOFError, pickle.UnpicklingError, zipfile.BadZipFile, ValueError,
+               KeyError, TypeError)
+
+
+class _Sequence:
+    """The snapshot folder and how many fits have taken a snapshot file from it."""
+
+    def __init__(self, folder: Path) -> None:
+        self.folder = folder
+        self.calls = 0
+
+
+_ACTIVE: contextvars.ContextVar[_Sequence | None] = contextvars.ContextVar(
+    "smpl_snapshots", default=None
+)
+
+
+@contextlib.contextmanager
+def resumable(folder: str | os.PathLike[str]) -> Iterator[None]:
+    """Makes every `fit` inside the block keep a snapshot under `folder` (module docstring)."""
+    token = _ACTIVE.set(_Sequence(Path(folder)))
+    try:
+        yield
+    finally:
+        _ACTIVE.reset(token)
+
+
+def next_path() -> Path | None:
+    """The snapshot file of the `fit` call now starting, or None outside `resumable`."""
+    sequence = _ACTIVE.get()
+    if sequence is None:
+        return None
+    sequence.calls += 1
+    return sequence.folder / f"fit-{sequence.calls}.pt"
+
+
+def save(path: Path, fingerprint: str, state: dict[str, Any]) -> None:
+    """Writes `state` (tensors, numbers, lists) to `path` through a temporary file and a rename."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(handle, "wb") as file:
+            torch.save({"format": _FORMAT, "fingerprint": fingerprint, "state": state}, file)
+            file.flush()
+            os.fsync(file.fileno())
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+
+
+def load(path: Path, fingerprint: str) -> dict[str, Any] | None:
+    """The state saved at `path` for the fit with `fingerprint`, or None (absent, unreadable or
+    another fit's, with a warning for the last two)."""
+    if not path.exists():
+        return None
+    try:
+        payload = torch.load(path, map_location="cpu", weights_only=True)
+        if payload["format"] != _FORMAT:
+            raise ValueError("not a training snapshot")
+    except _UNREADABLE as error:
+        warnings.warn(f"{path}: unreadable training snapshot ({error}); training that model "
+                      f"from the start", RuntimeWarning, stacklevel=2)
+        return None
+    if payload["fingerprint"] != fingerprint:
+        warnings.warn(f"{path}: training snapshot of another config, data or initialisation; "
+                      f"training that model from the start", RuntimeWarning, stacklevel=2)
+        return None
+    return payload["state"]
+
+
+def discard(folder: str | os.PathLike[str]) -> None:
+    """Removes a snapshot folder once the training it served is saved for good."""
+    shutil.rmtree(folder, ignore_errors=True)
