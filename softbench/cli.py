@@ -425,6 +425,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
   args = build_parser().parse_args(argv)
+  run_module.one_line_warnings()
   try:
     args.run(args)
   except (ValueError, FileNotFoundError, FloatingPointError, video.RenderingUnavailable) as error:

@@ -23,6 +23,7 @@ import platform
 import signal
 import subprocess
 import time
+import warnings
 
 import torch
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
@@ -204,9 +205,16 @@ def _run_seed(seed: int, run: RunSettings,
   return seed_entry(seed, episode, robots.make(run.robot).with_faults(run.faults)), episode
 
 
-def _ignore_interrupts() -> None:
-  """Worker initialiser: Ctrl-C reaches the parent only, which stops the workers itself."""
+def one_line_warnings() -> None:
+  """Prints warnings as ``softbench: warning: MESSAGE``, without file, line and source."""
+  warnings.formatwarning = lambda message, *_, **__: f"softbench: warning: {message}\n"
+
+
+def _init_worker() -> None:
+  """Worker initialiser: Ctrl-C reaches the parent only, which stops the workers itself; warnings
+  print as in the parent."""
   signal.signal(signal.SIGINT, signal.SIG_IGN)
+  one_line_warnings()
 
 
 class WorkerDied(RuntimeError):
@@ -226,7 +234,7 @@ def _parallel(function, arguments: list[tuple], label: str, workers: int) -> lis
   progress = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                       TimeElapsedColumn())
   executor = futures.ProcessPoolExecutor(workers, multiprocessing.get_context("spawn"),
-                                         initializer=_ignore_interrupts)
+                                         initializer=_init_worker)
   try:
     with progress:
       bar = progress.add_task(f"{label} ({workers} processes)", total=len(arguments))

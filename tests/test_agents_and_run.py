@@ -2,6 +2,7 @@
 
 import json
 import pathlib
+import warnings
 
 import numpy as np
 import pytest
@@ -144,6 +145,13 @@ def test_run_refuses_bad_input_with_one_line(argv, message, capsys, tmp_path):
   lines = capsys.readouterr().err.strip().splitlines()
   assert len(lines) == 1 and message in lines[0]
   assert not list(pathlib.Path(tmp_path).glob("*.json"))
+
+
+def test_warnings_print_on_one_line(monkeypatch):
+  monkeypatch.setattr(warnings, "formatwarning", warnings.formatwarning)  # Restored afterwards.
+  run.one_line_warnings()
+  assert warnings.formatwarning("snapshot unreadable", RuntimeWarning, "training.py", 215,
+                                "saved = load()") == "softbench: warning: snapshot unreadable\n"
 
 
 def test_cli_lists_agents(capsys):
