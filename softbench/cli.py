@@ -427,7 +427,8 @@ def main(argv: list[str] | None = None) -> int:
   args = build_parser().parse_args(argv)
   run_module.one_line_warnings()
   try:
-    args.run(args)
+    with run_module.sigterm_as_interrupt():
+      args.run(args)
   except (ValueError, FileNotFoundError, FloatingPointError, video.RenderingUnavailable) as error:
     print(f"softbench: error: {error}", file=sys.stderr)
     return EXIT_USAGE

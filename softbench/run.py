@@ -13,7 +13,9 @@ With ``faults`` (``--fault MODULE:ACTUATOR:GAIN``, ``softbench.robots.faults``) 
 built for the healthy robot, as a deployed controller would be, and evaluated on the faulty one.
 """
 
+from collections.abc import Iterator
 from concurrent import futures
+import contextlib
 import dataclasses
 import datetime
 import multiprocessing
@@ -22,6 +24,7 @@ import pathlib
 import platform
 import signal
 import subprocess
+import threading
 import time
 import warnings
 
@@ -208,6 +211,24 @@ def _run_seed(seed: int, run: RunSettings,
 def one_line_warnings() -> None:
   """Prints warnings as ``softbench: warning: MESSAGE``, without file, line and source."""
   warnings.formatwarning = lambda message, *_, **__: f"softbench: warning: {message}\n"
+
+
+def _interrupt(signal_number: int, frame) -> None:
+  raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def sigterm_as_interrupt() -> Iterator[None]:
+  """Within the block (in the main thread), ``kill`` stops softbench as Ctrl-C does: the seed
+  workers are terminated rather than left running without their parent."""
+  if threading.current_thread() is not threading.main_thread():
+    yield
+    return
+  previous = signal.signal(signal.SIGTERM, _interrupt)
+  try:
+    yield
+  finally:
+    signal.signal(signal.SIGTERM, previous)
 
 
 def _init_worker() -> None:

@@ -1,5 +1,5 @@
 """Seeds in worker processes (``softbench.run``): results in order, errors raised, a dead worker
-reported instead of a hang, Ctrl-C stopping every worker."""
+reported instead of a hang, Ctrl-C or kill stopping every worker."""
 
 import os
 import signal
@@ -46,7 +46,8 @@ sys.path.insert(0, {tests!r})
 from softbench import run
 import test_parallel_seeds
 try:
-  run._parallel(test_parallel_seeds.sleep_long, [(0,), (1,)], "sleepers", workers=2)
+  with run.sigterm_as_interrupt():  # As softbench.cli.main runs every command.
+    run._parallel(test_parallel_seeds.sleep_long, [(0,), (1,)], "sleepers", workers=2)
 except KeyboardInterrupt:
   import multiprocessing
   print("children left:", len(multiprocessing.active_children()), flush=True)
@@ -58,11 +59,12 @@ def sleep_long(value):
   time.sleep(600)
 
 
-def test_ctrl_c_stops_every_worker():
+@pytest.mark.parametrize("stop", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "kill"])
+def test_ctrl_c_or_kill_stops_every_worker(stop):
   program = _INTERRUPTED_PROGRAM.format(tests=os.path.dirname(__file__))
   process = subprocess.Popen([sys.executable, "-c", program], stdout=subprocess.PIPE, text=True)
   assert process.stdout.readline().strip() == "worker started"
   time.sleep(1.0)
-  process.send_signal(signal.SIGINT)
+  process.send_signal(stop)
   out, _ = process.communicate(timeout=60)
   assert "children left: 0" in out
