@@ -101,7 +101,7 @@ class ProtocolResult:
 
 
 ProgressBars = Callable[[str], contextlib.AbstractContextManager[
-    Callable[[training.EpochReport], None] | None]]
+    smpl_protocol.EpochCallback | None]]
 """Given a label (``forward tendon-2 end-effector``), a context entered around that model's
 training that yields the callback its epochs report to (a progress bar), or None."""
 
