@@ -54,6 +54,12 @@ def save_checkpoint(
             for name, values in (normalisation or {}).items()
         },
     }
+    save_atomically(path, payload)
+
+
+def save_atomically(path: Path, payload: Any) -> None:
+    """`torch.save(payload)` to `path` through a temporary file in its folder and a rename, so a
+    crash never leaves half a file under the real name."""
     path.parent.mkdir(parents=True, exist_ok=True)
     handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:

@@ -17,7 +17,6 @@ import contextvars
 import os
 import pickle
 import shutil
-import tempfile
 import warnings
 import zipfile
 from collections.abc import Iterator
@@ -25,6 +24,8 @@ from pathlib import Path
 from typing import Any
 
 import torch
+
+from smpl.checkpoint import save_atomically
 
 SAVE_INTERVAL_S = 30.0
 """Least wall time (s) between two snapshots of a fit under way."""
@@ -67,17 +68,7 @@ def next_path() -> Path | None:
 
 def save(path: Path, fingerprint: str, state: dict[str, Any]) -> None:
     """Writes `state` (tensors, numbers, lists) to `path` through a temporary file and a rename."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(handle, "wb") as file:
-            torch.save({"format": _FORMAT, "fingerprint": fingerprint, "state": state}, file)
-            file.flush()
-            os.fsync(file.fileno())
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
+    save_atomically(path, {"format": _FORMAT, "fingerprint": fingerprint, "state": state})
 
 
 def load(path: Path, fingerprint: str) -> dict[str, Any] | None:
