@@ -26,7 +26,7 @@ models: $(STAMP)
 
 # Every agent on every task of the leaderboard's robots, then the Exp1S protocol, then the pages.
 # PROFILE=paper (default) is the paper's budget: hours per agent on a laptop CPU. Every run reuses
-# cached datasets and checkpoints, so an interrupted fill resumes; the pages show the newest record
+# cached datasets, checkpoints and training snapshots, so an interrupted fill resumes; the pages show the newest record
 # of each setting.
 PROFILE ?= paper
 LEADERBOARD_ROBOTS := tendon-3 pneumatic-433
