@@ -26,8 +26,8 @@ models: $(STAMP)
 
 # Every agent on every task of the leaderboard's robots, then the Exp1S protocol, then the pages.
 # PROFILE=paper (default) is the paper's budget: hours per agent on a laptop CPU. Every run reuses
-# cached datasets, checkpoints and training snapshots, so an interrupted fill resumes; the pages show the newest record
-# of each setting.
+# cached datasets, checkpoints and training snapshots, so an interrupted fill resumes; the pages
+# show the newest record of each setting.
 PROFILE ?= paper
 LEADERBOARD_ROBOTS := tendon-3 pneumatic-433
 LEADERBOARD_TASKS := babbling circle rectangle spiral reach
