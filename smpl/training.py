@@ -214,6 +214,7 @@ def fit(
             run.restore(saved)
             for report in run.history if on_epoch_end is not None else ():
                 on_epoch_end(report)
+        finished_before = run.finished
         last_saved = time.monotonic()
         while not run.finished and len(run.history) < config.max_epochs:
             started = time.perf_counter()
@@ -229,7 +230,7 @@ def fit(
             if on_epoch_end is not None:
                 on_epoch_end(report)
         run.finished = True
-        if snapshot:
+        if snapshot and not finished_before:
             snapshots.save(snapshot, fingerprint, run.state())
         model.load_state_dict(run.best_state)
         model.eval()

@@ -99,11 +99,14 @@ def test_finished_fit_returns_its_result_without_training(tmp_path, monkeypatch)
     first = forward_model()
     expected = train_forward(first)
   monkeypatch.setattr(training, "_train_epoch", lambda *args: pytest.fail("trained again"))
+  snapshot = tmp_path / "fit-1.pt"
+  written = snapshot.stat().st_mtime_ns
   again = forward_model()
   with snapshots.resumable(tmp_path):
     result = train_forward(again)
   assert same_weights(first, again) and not again.training
   assert result.history == expected.history
+  assert snapshot.stat().st_mtime_ns == written  # Nothing new to save.
 
 
 def test_each_fit_of_a_run_keeps_its_own_snapshot(tmp_path):
