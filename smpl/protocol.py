@@ -129,7 +129,8 @@ StageProgress = Callable[[int], contextlib.AbstractContextManager[EpochCallback 
 epochs report to (a progress bar), or None."""
 
 
-def no_stage_progress(stage: int) -> contextlib.AbstractContextManager[None]:
+def no_progress(key: object) -> contextlib.AbstractContextManager[None]:
+    """A progress factory (a ``StageProgress``, or any keyed one) that shows nothing."""
     return contextlib.nullcontext(None)
 
 
@@ -138,7 +139,7 @@ def train_progressively(
     tasks: Sequence[ColumnTask],
     config: InverseTrainingConfig = InverseTrainingConfig(),
     device: torch.device | None = None,
-    stage_progress: StageProgress = no_stage_progress,
+    stage_progress: StageProgress = no_progress,
 ) -> ProgressiveRun:
     """Trains one new column per task in order, scoring all columns so far after each stage."""
     first_new_column = network.num_columns

@@ -22,17 +22,14 @@ import time
 
 import numpy as np
 
-from smpl import checkpoint
 from smpl import progressive
 from smpl import protocol as smpl_protocol
-from smpl import snapshots
 from smpl import training
 from softbench import data
 from softbench import evaluation
 from softbench import metrics
 from softbench import profiles
 from softbench import protocols
-from softbench import storage
 from softbench import suite
 from softbench.agents import hyperparameters
 from softbench.agents import learned
@@ -119,23 +116,16 @@ def build(seed: int, profile: profiles.Profile, show_progress: bool = False) -> 
   arms = [arm for arm, _ in views_of]
   views = [view for _, view in views_of]
   config = _config(seed, profile, arms)
-  path = storage.softbench_home() / learned.CHECKPOINT_FOLDER / f"{config.key}.pt"
-  if path.exists():
-    network, forwards = learned.untrained(views, True, None, _params())
-    arrays = checkpoint.load_checkpoint(path, learned.bundle(network, forwards), config)
-    normalisations = [data.Normalisation.from_arrays(
-        {key.removeprefix(f"{arm.name}/"): value for key, value in arrays.items()
-         if key.startswith(f"{arm.name}/")}) for arm in arms]
-    matrices = {key: np.asarray(value) for key, value in arrays.items()
-                if key.startswith("forgetting/")}
-  else:
-    with snapshots.resumable(learned.snapshot_folder(path)):
-      network, forwards, normalisations, outcome = _train(seed, profile, show_progress)
-    matrices = _matrices(outcome)
-    arrays = {f"{arm.name}/{key}": value for arm, scale in zip(arms, normalisations)
-              for key, value in scale.to_arrays().items()}
-    checkpoint.save_checkpoint(path, learned.bundle(network, forwards), config, {**arrays, **matrices})
-    snapshots.discard(learned.snapshot_folder(path))
+
+  def train() -> learned.TrainedModels:
+    network, forwards, normalisations, outcome = _train(seed, profile, show_progress)
+    return learned.TrainedModels(network, forwards, normalisations, _matrices(outcome))
+
+  models = learned.load_or_train(learned.checkpoint_file(config), config,
+                                 [arm.name for arm in arms],
+                                 lambda: learned.untrained(views, True, None, _params()), train)
+  network, forwards, normalisations = models.inverse, models.forwards, models.normalisations
+  matrices = models.arrays
   network.eval()
   controllers = [learned.Controller(view, forward.eval(), scale)
                  for view, forward, scale in zip(views, forwards, normalisations)]

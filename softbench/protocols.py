@@ -106,15 +106,11 @@ ProgressBars = Callable[[str], contextlib.AbstractContextManager[
 training that yields the callback its epochs report to (a progress bar), or None."""
 
 
-def no_progress_bars(label: str) -> contextlib.AbstractContextManager[None]:
-  return contextlib.nullcontext(None)
-
-
 def run(protocol: Protocol, samples: int = data.DEFAULT_SAMPLES, seed: int = 0,
         forward_config: training.ForwardTrainingConfig = training.ForwardTrainingConfig(),
         inverse_config: training.InverseTrainingConfig = training.InverseTrainingConfig(),
         device: torch.device | None = None, progress: bool = True,
-        progress_bars: ProgressBars = no_progress_bars) -> ProtocolResult:
+        progress_bars: ProgressBars = smpl_protocol.no_progress) -> ProtocolResult:
   """Collects (or finds) each robot's dataset (babbling seed ``seed``), prepares every column,
   then trains the progressive network column by column (``smpl.protocol.train_progressively``,
   or all columns acting together for a per-module protocol). The configs' seeds fix the weights.

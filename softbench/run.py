@@ -196,16 +196,23 @@ def evaluate(agent: agents.Agent, arm: robots.SoftArm, run: RunSettings, seed: i
 def seed_episode(run: RunSettings, seed: int, show_progress: bool = False) -> evaluation.Episode:
   """Builds (trains) the agent of ``seed`` for the healthy robot, as a deployed controller would
   be, and runs it through one episode on the robot with ``run.faults``."""
+  return _episode_and_arm(run, seed, show_progress)[0]
+
+
+def _episode_and_arm(run: RunSettings, seed: int, show_progress: bool
+                     ) -> tuple[evaluation.Episode, robots.SoftArm]:
+  """``seed_episode``, and the (faulty) robot it ran on."""
   arm = robots.make(run.robot)
   agent = agents.make(run.agent, arm, seed, run.profile, show_progress)
-  return episode_on(agent, arm.with_faults(run.faults), run, seed, show_progress)
+  faulty = arm.with_faults(run.faults)
+  return episode_on(agent, faulty, run, seed, show_progress), faulty
 
 
 def _run_seed(seed: int, run: RunSettings,
               show_progress: bool) -> tuple[dict, evaluation.Episode]:
   """The episode of ``seed`` (``seed_episode``) and its record entry."""
-  episode = seed_episode(run, seed, show_progress)
-  return seed_entry(seed, episode, robots.make(run.robot).with_faults(run.faults)), episode
+  episode, arm = _episode_and_arm(run, seed, show_progress)
+  return seed_entry(seed, episode, arm), episode
 
 
 def one_line_warnings() -> None:

@@ -92,6 +92,14 @@ def test_interrupted_training_resumes_to_the_same_checkpoint(agent_name, tmp_pat
   assert not folder.exists()
 
 
+def test_a_checkpoints_further_arrays_may_not_use_a_parts_name(tmp_path):
+  # They would be read back as that part's normalisation.
+  clashing = learned.TrainedModels(None, [], [], {"module-1/mean": np.zeros(3)})
+  with pytest.raises(ValueError, match="clash"):
+    learned.load_or_train(tmp_path / "agent.pt", None, ["module-1"], None, lambda: clashing)
+  assert not (tmp_path / "agent.pt").exists()
+
+
 @pytest.mark.parametrize("mode", learned.ERROR_SOURCES)
 def test_error_sources_differ_after_the_first_step(mode):
   agent = agents.make("smpl", "tendon-2", 0, "tiny")

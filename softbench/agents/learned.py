@@ -378,6 +378,45 @@ def checkpoint_file(config: TrainedConfig) -> pathlib.Path:
   return storage.softbench_home() / CHECKPOINT_FOLDER / f"{config.key}.pt"
 
 
+@dataclasses.dataclass
+class TrainedModels:
+  """What a checkpoint holds: the inverse model, the forward models, the normalisation of each
+  named part (a view, or a robot of a protocol) and any further named arrays."""
+  inverse: InverseModel
+  forwards: list[smpl_forward.ForwardModel]
+  normalisations: list[data.Normalisation]
+  arrays: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
+
+
+def load_or_train(path: pathlib.Path, config, parts: list[str],
+                  untrained_models: Callable[[], tuple[InverseModel,
+                                                       list[smpl_forward.ForwardModel]]],
+                  train: Callable[[], TrainedModels]) -> TrainedModels:
+  """The models of the checkpoint at ``path`` (saved for ``config``) when it exists, loaded into
+  ``untrained_models()``. Otherwise ``train()``'s, trained so that an interrupted training resumes
+  (snapshots in ``snapshot_folder(path)``) and then saved there: normalisation i as
+  ``parts[i]/KEY``, the further arrays under their own names (no part's prefix)."""
+  if path.exists():
+    inverse, forwards = untrained_models()
+    stored = checkpoint.load_checkpoint(path, bundle(inverse, forwards), config)
+    normalisations = [data.Normalisation.from_arrays(
+        {key.removeprefix(f"{part}/"): value for key, value in stored.items()
+         if key.startswith(f"{part}/")}) for part in parts]
+    arrays = {key: np.asarray(value) for key, value in stored.items()
+              if key.split("/")[0] not in parts}
+    return TrainedModels(inverse, forwards, normalisations, arrays)
+  with snapshots.resumable(snapshot_folder(path)):
+    models = train()
+  if set(key.split("/")[0] for key in models.arrays) & set(parts):
+    raise ValueError(f"further arrays {sorted(models.arrays)} clash with the parts {parts}")
+  scales = {f"{part}/{key}": value for part, scale in zip(parts, models.normalisations)
+            for key, value in scale.to_arrays().items()}
+  checkpoint.save_checkpoint(path, bundle(models.inverse, models.forwards), config,
+                             {**scales, **models.arrays})
+  snapshots.discard(snapshot_folder(path))
+  return models
+
+
 def snapshot_folder(checkpoint_path: pathlib.Path) -> pathlib.Path:
   """Where the training of a checkpoint keeps its snapshots until the checkpoint is written, so
   that an interrupted training resumes (``smpl.snapshots``)."""
@@ -391,21 +430,14 @@ def build_agent(name: str, robot: robot_base.SoftArm, seed: int, profile: profil
   views = Learner(name, per_module, make_model).views(robot)
   params = hyperparameters.values(name, robot.name)
   config = trained_config(name, robot, views, seed, profile, params)
-  path = checkpoint_file(config)
-  if path.exists():
-    inverse, forwards = untrained(views, per_module, make_model, params)
-    arrays = checkpoint.load_checkpoint(path, bundle(inverse, forwards), config)
-    normalisations = [data.Normalisation.from_arrays(
-        {key.removeprefix(f"{view.name}/"): value for key, value in arrays.items()
-         if key.startswith(f"{view.name}/")}) for view in views]
-  else:
-    with snapshots.resumable(snapshot_folder(path)):
-      inverse, forwards, normalisations = _train(name, robot, views, seed, profile, per_module,
-                                                 make_model, params, show_progress)
-    arrays = {f"{view.name}/{key}": value for view, scale in zip(views, normalisations)
-              for key, value in scale.to_arrays().items()}
-    checkpoint.save_checkpoint(path, bundle(inverse, forwards), config, arrays)
-    snapshots.discard(snapshot_folder(path))
+
+  def train() -> TrainedModels:
+    return TrainedModels(*_train(name, robot, views, seed, profile, per_module, make_model,
+                                 params, show_progress))
+
+  models = load_or_train(checkpoint_file(config), config, [view.name for view in views],
+                         lambda: untrained(views, per_module, make_model, params), train)
+  inverse, forwards, normalisations = models.inverse, models.forwards, models.normalisations
   inverse.eval()
   controllers = [Controller(view, forward.eval(), scale)
                  for view, forward, scale in zip(views, forwards, normalisations)]
