@@ -212,8 +212,11 @@ def _run(args: argparse.Namespace) -> None:
     run_module.write_record(record, pathlib.Path(args.json))
   for plot in plots.save_run_plots(path, record, episodes) if episodes else ():
     print(f"plot: {plot}")
-  if args.video:
+  if args.video:  # Once the record is safe; then the record links the video.
     _write_video(settings, 0, episodes[0], video_path, options)
+    for record_file in [path] + ([pathlib.Path(args.json)] if args.json else []):
+      record["video"] = os.path.relpath(video_path.resolve(), record_file.parent.resolve())
+      run_module.write_record(record, record_file)
 
 
 def _render(args: argparse.Namespace) -> None:

@@ -13,6 +13,7 @@ from softbench import cli
 from softbench import evaluation
 from softbench import plots
 from softbench import suite
+from softbench.leaderboard import records
 
 
 @pytest.fixture(autouse=True)
@@ -88,3 +89,7 @@ def test_softbench_run_saves_plots_and_a_video(tmp_path, capsys):
     assert f"plot: {path}" in out and png_size(path)[0] > 100
   assert f"video: {video} (5 frames" in out
   assert imageio_ffmpeg.count_frames_and_secs(str(video))[0] == 5
+  assert records.read(record_path)["video"] == "../run.mp4"  # Relative to the record's folder.
+  pages = tmp_path / "pages"
+  assert cli.main(["leaderboard", "--results", str(results), "--write", "--out", str(pages)]) == 0
+  assert "[video](<../run.mp4>)" in (pages / "README.md").read_text()
