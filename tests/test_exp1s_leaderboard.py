@@ -301,7 +301,7 @@ def test_pages_contain_every_exp1s_record(results, tmp_path, capsys):
             assert cell in printed and cell in markdown and cell in page
   for text in (printed, markdown, page):
     assert "tendon-1 · circle" in text and "tab_exp1s_error" in text
-  assert page.count('<table class="exp1s heat">') == 4  # One forgetting heat map per entry.
+  assert page.count('<table class="figures heat">') == 4  # One forgetting heat map per entry.
   shown_configurations = 2 + 5 + 5 + 5  # The two-configuration entry, then three of five.
   assert page.count('<tr class="paper">') == shown_configurations * len(continual.LOOPS)
   high = f"background:#{''.join(f'{c:02x}' for c in html_page._HEAT_HIGH)}"

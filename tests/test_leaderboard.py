@@ -18,6 +18,7 @@ from scipy import stats
 from softbench import cli
 from softbench import leaderboard
 from softbench import run
+from softbench.leaderboard import overview
 from softbench.leaderboard import ranking
 from softbench.leaderboard import records
 
@@ -208,6 +209,45 @@ def test_ranking(results):
   assert board.groups[2].metrics == ("position_mm", "normalised_tip_percent")
 
 
+def test_the_overview_shows_every_plain_task_of_every_agent(results):
+  board = leaderboard.build(results)
+  (view,) = overview.overviews(board)
+  assert (view.robot, view.profile, view.eval_mode) == ("tendon-1", "tiny", "physics")
+  assert view.table.header == ("agent", "circle", "reach")
+  rows = {row[0]: row[1:] for row in view.table.rows}
+  assert list(rows) == ["zero", "bad", "good", "single"]  # Registered agents first.
+  shown = 0
+  for group in board.groups:
+    for entry in group.entries if not group.variant else ():  # Not the fault's group.
+      cell = rows[entry.record["agent"]][view.table.header.index(group.task) - 1]
+      assert cell == ranking.mean_and_std(entry.estimates["position_mm"])
+      shown += 1
+  assert shown == 5 and rows["good"][1] == "-"  # Good has no reach record.
+  assert "no table for this robot" in view.table.caption
+
+
+def test_the_overview_shows_the_papers_value_beside_ours(real_record, tmp_path):
+  experiments = overview.paper()["experiments"]
+  assert set(experiments) == {"tendon-3", "pneumatic-433"}
+  for experiment in experiments.values():
+    for scores in experiment["scores"].values():
+      for pairs in scores.values():
+        assert len(pairs) == len(experiment["agents"])
+        assert all(mean > 0 and std >= 0 for mean, std in pairs)
+  assert overview.paper_mean("tendon-3", "spiral", "smpl") == 1.24  # Table sim_robo_exp2S.
+  assert overview.paper_mean("tendon-3", "reach", "smpl") is None  # Not in the paper.
+  assert overview.paper_mean("tendon-3", "spiral", "zero") is None
+  folder = tmp_path / "results"
+  for robot in experiments:
+    run.write_record(variant(real_record, agent="smpl", robot=robot), folder / f"{robot}.json")
+  views = overview.overviews(leaderboard.build(folder))
+  assert [view.robot for view in views] == ["pneumatic-433", "tendon-3"]
+  for view, name in zip(views, ("Exp2R", "Exp2S")):
+    ((agent, cell),) = view.table.rows
+    assert f"the paper's {name} mean" in view.table.caption
+    assert cell.endswith(f" ({overview.paper_mean(view.robot, 'circle', 'smpl'):.2f})")
+
+
 def test_pages_contain_every_record(results, tmp_path, capsys):
   out = tmp_path / "site"
   assert cli.main(["leaderboard", "--results", str(results), "--write", "--out", str(out)]) == 0
@@ -220,6 +260,7 @@ def test_pages_contain_every_record(results, tmp_path, capsys):
     assert f'href="../results/{path.name}"' in page
   for text in (printed, markdown, page):
     assert "tendon-1 · circle (with fault)" in text and "tendon-1 · reach" in text
+    assert "tendon-1 overview · tiny profile · physics" in text
   assert "(<../results/videos/zero.mp4>)" in markdown and 'href="../results/videos/zero.mp4"' in page
   assert 'href="https://example.org/good.mp4"' in page
   assert page.count("<table class=\"sortable\">") == 3 and page.count("<svg") == 3 + 3 + 2

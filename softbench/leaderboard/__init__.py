@@ -3,9 +3,10 @@
 ``records`` (schema, integrity hash, checked reading and writing, for every kind of record),
 ``record_fields`` (the fields every kind shares), ``exp1s_records`` (the Exp1S record's schema
 and checks), ``ranking`` (newest record per agent, profile and eval mode; mean, std and
-bootstrap interval over seeds), ``exp1s_board`` (Exp1S records in the paper's layout, beside the
-paper's values), ``text`` (the printout), ``markdown_page`` and ``html_page`` (``README.md`` and
-``index.html``).
+bootstrap interval over seeds), ``overview`` (every agent on every task of a robot, beside the
+paper's Exp2S/Exp2R values), ``exp1s_board`` (Exp1S records in the paper's layout, beside the
+paper's values), ``figure_table`` (the tables every page renders alike), ``text`` (the printout),
+``markdown_page`` and ``html_page`` (``README.md`` and ``index.html``).
 """
 
 import pathlib

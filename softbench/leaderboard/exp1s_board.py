@@ -24,6 +24,7 @@ import re
 from softbench import continual
 from softbench import metrics
 from softbench.leaderboard import exp1s_records
+from softbench.leaderboard.figure_table import Table
 from softbench.leaderboard import records
 from softbench.leaderboard import selection
 
@@ -32,19 +33,6 @@ PAPER_METRICS = {"position_mm": "pos (mm)", "orientation_deg": "ori (deg)"}
 SOURCES = ("softbench", "paper")  # The two rows of each configuration.
 LOOP_LABELS = {"closed": "closed loop (softbench: error measured in physics)",
                "open": "open loop (no error fed back)"}
-
-
-@dataclasses.dataclass(frozen=True)
-class Table:
-  """A table as every page shows it: a caption, a header and rows of cells (strings), the first
-  ``label_columns`` of them labels, the others figures; ``paper_rows``: the indices of the rows
-  that hold the paper's values."""
-
-  caption: str
-  header: tuple[str, ...]
-  rows: tuple[tuple[str, ...], ...]
-  label_columns: int
-  paper_rows: tuple[int, ...] = ()
 
 
 @functools.cache

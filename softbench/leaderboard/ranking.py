@@ -126,7 +126,8 @@ def _group_key(record: dict) -> tuple[str, str, str]:
   return record["robot"], record["task"], ", ".join(variant)
 
 
-def _robot_order(robot: str) -> tuple:
+def robot_order(robot: str) -> tuple:
+  """Robots by family, then module count (tendon-2 before tendon-10)."""
   family, _, size = robot.partition("-")
   return family, int(size) if size.isdigit() else 0, robot
 
@@ -145,7 +146,7 @@ def rank(loaded: list[tuple[pathlib.Path, dict]]) -> Leaderboard:
     if record["format"] == records.FORMAT and record["per_seed"]:
       by_group.setdefault(_group_key(record), []).append(Entry.of(path, record))
   groups = []
-  for key in sorted(by_group, key=lambda k: (_robot_order(k[0]), suite.TASKS.index(k[1]), k[2])):
+  for key in sorted(by_group, key=lambda k: (robot_order(k[0]), suite.TASKS.index(k[1]), k[2])):
     shown, superseded = selection.newest_per_setting(by_group[key])
     ranked = sorted(shown,
                     key=lambda entry: (entry.estimates[RANKED_BY].mean, entry.setting))
@@ -167,13 +168,19 @@ def number(value: float, decimals: int | None = None) -> str:
   return f"{value:.{_decimals(value) if decimals is None else decimals}f}"
 
 
+def mean_and_std(estimate: Estimate) -> str:
+  """``mean ± std``, both with the decimals of the mean."""
+  decimals = _decimals(estimate.mean)
+  return f"{number(estimate.mean, decimals)} ± {number(estimate.std, decimals)}"
+
+
 def cell(estimate: Estimate | None) -> str:
   """``mean ± std [low, high]``, all with the decimals of the mean; ``-`` for a metric the
   record does not hold."""
   if estimate is None:
     return "-"
   decimals = _decimals(estimate.mean)
-  text = f"{number(estimate.mean, decimals)} ± {number(estimate.std, decimals)}"
+  text = mean_and_std(estimate)
   if estimate.interval is not None:
     low, high = estimate.interval
     text += f" [{number(low, decimals)}, {number(high, decimals)}]"

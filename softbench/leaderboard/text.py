@@ -1,8 +1,11 @@
-"""The ranking as ``softbench leaderboard`` prints it: one aligned table per robot and task."""
+"""The ranking as ``softbench leaderboard`` prints it: the overviews, then one aligned table per
+robot and task, then the Exp1S sections."""
 
 import pathlib
 
 from softbench.leaderboard import exp1s_board
+from softbench.leaderboard import figure_table
+from softbench.leaderboard import overview
 from softbench.leaderboard import ranking
 from softbench.leaderboard import records
 
@@ -49,8 +52,8 @@ def table(group: ranking.Group) -> str:
   return "\n".join(lines)
 
 
-def exp1s_table(table: exp1s_board.Table) -> list[str]:
-  """One table of an Exp1S entry: its caption, then the aligned header and rows."""
+def figure_rows(table: figure_table.Table) -> list[str]:
+  """A table of figures: its caption, then the aligned header and rows."""
   rows = [list(table.header), *map(list, table.rows)]
   right = set(range(table.label_columns, len(table.header)))
   return [f"  {table.caption}", *("    " + line for line in _aligned(rows, right))]
@@ -62,14 +65,23 @@ def exp1s_section(group: exp1s_board.Group) -> str:
   for entry in group.entries:
     lines.append(f"  {exp1s_board.describe(entry)}, {entry.path.name}")
     for exp1s in exp1s_board.tables(entry):
-      lines += exp1s_table(exp1s)
+      lines += figure_rows(exp1s)
   for entry in group.superseded:
     lines.append(f"  superseded: {entry.path.name} ({entry.label}, {entry.record['date']})")
   lines.append(f"  {exp1s_board.about_paper()}")
   return "\n".join(lines)
 
 
+def overview_section(views: tuple[overview.Overview, ...]) -> list[str]:
+  """Every overview (its title and table), then what the bracketed values are."""
+  if not views:
+    return []
+  return [*("\n".join([view.title, *figure_rows(view.table)]) for view in views),
+          overview.about_paper()]
+
+
 def report(board: ranking.Leaderboard, results: pathlib.Path) -> str:
   """The whole printout."""
-  return "\n\n".join([summary(board, results), *(table(group) for group in board.groups),
+  return "\n\n".join([summary(board, results), *overview_section(overview.overviews(board)),
+                       *(table(group) for group in board.groups),
                        *(exp1s_section(group) for group in board.exp1s)])

@@ -1,0 +1,101 @@
+"""Overview tables: every agent on every task of a robot at a glance, beside the paper's values.
+
+One table per robot, profile (paper first) and eval mode (physics first): agents by rows
+(registry order, then any others by name), the tasks that have a record by columns (suite order). A cell is the position error (mm)
+of the row that the task's ranking shows for that agent, profile and eval mode (its newest
+record): mean ± std over seeds of the episode's module-averaged error. Where the paper reports
+the same robot, task and agent (``paper_exp2.json``: Exp2S for tendon-3, Exp2R for
+pneumatic-433), the paper's mean follows in brackets. Only plain tasks count: a custom
+trajectory, a fault or an extra section is a different experiment.
+"""
+
+import dataclasses
+import functools
+import importlib.resources
+import json
+
+from softbench import agents
+from softbench import profiles
+from softbench import suite
+from softbench.agents import learned
+from softbench.leaderboard import ranking
+from softbench.leaderboard.figure_table import Table
+
+PAPER_FILE = "paper_exp2.json"  # In this package; its "source" names the paper's tables.
+METRIC = "position_mm"
+
+
+@functools.cache
+def paper() -> dict:
+  """The paper's Exp2S and Exp2R tables (``paper_exp2.json``): source, note and, per robot,
+  ``experiments[robot]``: name, agents and ``scores[task][metric]``, one [mean, std] per agent."""
+  text = importlib.resources.files(__package__).joinpath(PAPER_FILE).read_text(encoding="utf-8")
+  return json.loads(text)
+
+
+def paper_mean(robot: str, task: str, agent: str) -> float | None:
+  """The paper's mean position error (mm) of ``agent`` on ``robot``'s ``task``, if it has one."""
+  experiment = paper()["experiments"].get(robot)
+  if experiment is None or agent not in experiment["agents"] or task not in experiment["scores"]:
+    return None
+  return experiment["scores"][task][METRIC][experiment["agents"].index(agent)][0]
+
+
+@dataclasses.dataclass(frozen=True)
+class Overview:
+  robot: str
+  profile: str
+  eval_mode: str
+  table: Table
+
+  @property
+  def title(self) -> str:
+    return f"{self.robot} overview · {self.profile} profile · {self.eval_mode}"
+
+  @property
+  def anchor(self) -> str:
+    return f"overview-{self.robot}-{self.profile}-{self.eval_mode}"
+
+
+def _known_first(name: str, known) -> tuple:
+  """Sort key: the ``known`` names in their order, then any others by name."""
+  known = list(known)
+  return (0, known.index(name), "") if name in known else (1, 0, name)
+
+
+def _cell(estimate: ranking.Estimate, reference: float | None) -> str:
+  text = ranking.mean_and_std(estimate)
+  return text if reference is None else f"{text} ({reference:.2f})"
+
+
+def overviews(board: ranking.Leaderboard) -> tuple[Overview, ...]:
+  """The overview of every robot, profile and eval mode with a plain-task record on ``board``."""
+  cells: dict[tuple[str, str, str], dict[tuple[str, str], ranking.Estimate]] = {}
+  for group in board.groups:
+    if group.variant:
+      continue
+    for entry in group.entries:
+      agent, profile, eval_mode = entry.setting
+      cells.setdefault((group.robot, profile, eval_mode), {})[agent, group.task] = (
+          entry.estimates[METRIC])
+  tables = []
+  for (robot, profile, eval_mode), estimates in cells.items():  # Already in the groups' order.
+    tasks = sorted({task for _, task in estimates}, key=suite.TASKS.index)
+    names = sorted({agent for agent, _ in estimates}, key=lambda agent: _known_first(agent, agents.AGENTS))
+    experiment = paper()["experiments"].get(robot)
+    caption = ("position error (mm), mean ± std over seeds of the module-averaged error; " +
+               (f"in brackets the paper's {experiment['name']} mean" if experiment else
+                "the paper has no table for this robot"))
+    rows = tuple((agent, *(_cell(estimates[agent, task], paper_mean(robot, task, agent))
+                           if (agent, task) in estimates else "-" for task in tasks))
+                 for agent in names)
+    tables.append(Overview(robot, profile, eval_mode,
+                           Table(caption, ("agent", *tasks), rows, label_columns=1)))
+  return tuple(sorted(tables, key=lambda view: (ranking.robot_order(view.robot),
+                                                _known_first(view.profile, profiles.PROFILES),
+                                                _known_first(view.eval_mode, learned.ERROR_SOURCES))))
+
+
+def about_paper() -> str:
+  """What the bracketed values are and how they differ from ours, for each page."""
+  return f"Bracketed values: {paper()['source']} {paper()['note']}"
