@@ -2,6 +2,7 @@
 
 import json
 import pathlib
+import shutil
 import warnings
 
 import numpy as np
@@ -13,8 +14,10 @@ from smpl import training
 from softbench import agents
 from softbench import cli
 from softbench import evaluation
+from softbench import protocols
 from softbench import run
 from softbench import suite
+from softbench.agents import forward_models
 from softbench.agents import learned
 
 TASKS = (("tendon-2", "circle"), ("pneumatic-433", "spiral"), ("tendon-2", "reach"))
@@ -69,6 +72,7 @@ def test_interrupted_training_resumes_to_the_same_checkpoint(agent_name, tmp_pat
   (checkpoint,) = (tmp_path / learned.CHECKPOINT_FOLDER).glob(f"{agent_name}-*.pt")
   uninterrupted = torch.load(checkpoint, weights_only=False)["state_dict"]
   checkpoint.unlink()
+  shutil.rmtree(tmp_path / forward_models.FOLDER)  # From scratch: the forward models too.
   epochs, train_epoch = 0, training._train_epoch
 
   def interrupted_in_the_fourth_epoch(*args):
@@ -82,14 +86,39 @@ def test_interrupted_training_resumes_to_the_same_checkpoint(agent_name, tmp_pat
   monkeypatch.setattr(training, "_train_epoch", interrupted_in_the_fourth_epoch)
   with pytest.raises(KeyboardInterrupt):
     agents.make(agent_name, "tendon-2", 0, "tiny")
-  folder = learned.snapshot_folder(checkpoint)
-  assert sorted(path.name for path in folder.iterdir())[:2] == ["fit-1.pt", "fit-2.pt"]
+  # The fit under way kept a snapshot: an inverse model's in the checkpoint's folder, or (SMPL,
+  # with a forward model per module) a forward model's in its cache file's folder.
+  assert list(tmp_path.rglob("*.partial/fit-1.pt"))
   monkeypatch.setattr(training, "_train_epoch", train_epoch)
   agents.make(agent_name, "tendon-2", 0, "tiny")
   resumed = torch.load(checkpoint, weights_only=False)["state_dict"]
   assert resumed.keys() == uninterrupted.keys()
   assert all(torch.equal(resumed[key], uninterrupted[key]) for key in resumed)
-  assert not folder.exists()
+  assert not list(tmp_path.rglob("*.partial"))
+
+
+def test_agents_reading_the_same_view_share_one_forward_model(tmp_path, monkeypatch):
+  trained_views, prepare_column = [], protocols.prepare_column
+
+  def counted(robot, view, *args):
+    trained_views.append(view.name)
+    return prepare_column(robot, view, *args)
+
+  monkeypatch.setattr(protocols, "prepare_column", counted)
+
+  def lstm_weights(home, agent_names):
+    monkeypatch.setenv("SOFTBENCH_HOME", str(home))
+    for name in agent_names:
+      agents.make(name, "tendon-2", 0, "tiny")
+    (path,) = (home / learned.CHECKPOINT_FOLDER).glob("lstm-*.pt")
+    return torch.load(path, weights_only=False)["state_dict"]
+
+  alone = lstm_weights(tmp_path / "alone", ["lstm"])
+  assert trained_views == ["whole-arm"]
+  shared = lstm_weights(tmp_path / "shared", ["mlp", "lstm"])
+  assert trained_views == ["whole-arm", "whole-arm"]  # The MLP trained it; the LSTM found it.
+  assert alone.keys() == shared.keys()
+  assert all(torch.equal(alone[key], shared[key]) for key in alone)  # As if trained itself.
 
 
 def test_a_checkpoints_further_arrays_may_not_use_a_parts_name(tmp_path):

@@ -55,7 +55,9 @@ except KeyboardInterrupt:
 
 
 def sleep_long(value):
-  print("worker started", flush=True)
+  # One write (print writes the text and the newline apart), so two workers' lines never mix.
+  sys.stdout.write("worker started\n")
+  sys.stdout.flush()
   time.sleep(600)
 
 

@@ -1,8 +1,9 @@
 """Learned agents: inverse models trained on motor babbling in closed loop, then acting on a task.
 
 Training (cached): the robot's babbling dataset (``softbench.data.collect``, data seed 0, the
-profile's sample count), cut into each controller's view; a forward model per view, then the
-inverse model in closed loop through it (``smpl.training``), seeded by the agent's seed. SMPL has
+profile's sample count), cut into each controller's view; a forward model per view (trained once
+and shared by the agents that read the same view, ``forward_models``), then the inverse model in
+closed loop through it (``smpl.training``), seeded by the agent's seed. SMPL has
 one progressive column per module (``View.module``, trained in order, earlier columns frozen);
 the baselines are one centralised model over the whole arm (``View.whole_arm``). Each agent
 trains with its committed hyperparameters (``softbench.agents.hyperparameters``), which enter the
@@ -50,9 +51,9 @@ from smpl import windows as smpl_windows
 from smpl.inverse import InverseModel
 from softbench import data
 from softbench import profiles
-from softbench import protocols
 from softbench import storage
 from softbench.agents import base
+from softbench.agents import forward_models
 from softbench.agents import hyperparameters
 from softbench.robots import base as robot_base
 
@@ -278,20 +279,24 @@ def _train(name: str, robot: robot_base.SoftArm, views: list[data.View], seed: i
            profile: profiles.Profile, per_module: bool, make_model: ModelFactory, params: dict,
            show: bool
            ) -> tuple[InverseModel, list[smpl_forward.ForwardModel], list[data.Normalisation]]:
-  """Collects or finds the dataset, then trains forward and inverse models (module docstring)."""
-  dataset = data.collect(robot, samples=profile.samples, seed=DATA_SEED, progress=show)
-  label = f"{name} {robot.name} seed {seed}"
-  prepared = []
-  for view in views:
-    with progress_bar(f"forward {label} {view.name}", profile.max_epochs, show) as bar:
-      prepared.append(protocols.prepare_column(robot, view, dataset,
-                                               forward_config(seed, profile),
-                                               training.default_device(), bar))
-  windows = [column.windows for column in prepared]
-  forwards = [column.forward_model for column in prepared]
+  """Collects or finds the dataset, then trains (or finds) the forward models and trains the
+  inverse model (module docstring)."""
+  windows, forwards = trained_forward_models(robot, views, seed, profile, show)
   inverse, _ = train_inverse(views, windows, forwards, seed, profile, per_module, make_model,
-                             params, label if show else None)
+                             params, f"{name} {robot.name} seed {seed}" if show else None)
   return inverse, forwards, [split.normalisation for split in windows]
+
+
+def trained_forward_models(robot: robot_base.SoftArm, views: list[data.View], seed: int,
+                           profile: profiles.Profile, show_progress: bool = False
+                           ) -> tuple[list[data.SplitWindows], list[smpl_forward.ForwardModel]]:
+  """Each view's windows of the profile's babbling dataset (collected or found) and its frozen
+  forward model, trained with ``forward_config(seed, profile)`` or found in the cache that every
+  agent and tuning trial reading the same view shares (``forward_models``)."""
+  dataset = data.collect(robot, samples=profile.samples, seed=DATA_SEED, progress=show_progress)
+  return forward_models.prepare(robot, views, dataset, profile.samples, DATA_SEED,
+                                forward_config(seed, profile), TRAINING_VERSION,
+                                f"forward {robot.name} seed {seed}" if show_progress else None)
 
 
 def train_inverse(views: list[data.View], windows: list[data.SplitWindows],

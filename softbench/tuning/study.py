@@ -3,7 +3,7 @@
 Every learned agent gets the same study: its search space (``agents.hyperparameters``), the same
 number of trials, a seeded TPE sampler and a median pruner fed with per-epoch validation losses.
 A trial trains the agent's inverse model with the sampled values in closed loop through frozen
-forward models (trained once, ``tuning.forward_models``), on the profile's babbling dataset and
+forward models (trained once and shared, ``agents.forward_models``), on the profile's babbling dataset and
 with the study's seed, as ``softbench run`` trains the agent's seed (for at most ``epochs``
 epochs, the profile's unless a study asks for fewer to afford more trials); its value is the
 best validation loss: the action MSE over the whole arm on the validation split, in normalised
@@ -41,7 +41,6 @@ from softbench import robots
 from softbench import storage
 from softbench.agents import hyperparameters
 from softbench.agents import learned
-from softbench.tuning import forward_models
 
 DEFAULT_TRIALS = 10  # Trials per study, the same for every agent (README: budget).
 DATABASE = "tuning.db"  # Default SQLite storage, under the data home.
@@ -193,8 +192,8 @@ class _Trainer:
     self.space = hyperparameters.search_space(settings.agent)
     arm = robots.make(settings.robot)
     self.views = self.learner.views(arm)
-    self.windows, self.forwards = forward_models.prepare(arm, self.views, settings.profile,
-                                                         settings.seed, show_progress)
+    self.windows, self.forwards = learned.trained_forward_models(
+        arm, self.views, settings.seed, settings.profile, show_progress)
 
   def validation_loss(self, params: dict, profile: profiles.Profile,
                       on_epoch: learned.EpochCallback | None = None) -> float:

@@ -1,0 +1,88 @@
+"""Frozen forward models, trained once and shared by every agent and tuning trial that needs them.
+
+A forward model's weights depend on the robot, the view it predicts, the babbling dataset and its
+training config (the paper's, seeded by the agent's seed), not on the inverse model trained
+through it. So the agents that read the same view with the same seed and profile (the four
+baselines' whole-arm model) and every trial of a tuning study share one: trained as
+``smpl.protocols``' ``prepare_column`` trains it, cached under ``$SOFTBENCH_HOME/forward`` by a
+hash of everything its weights depend on (``ForwardModelConfig``), and loaded with the weights a
+fresh training gives, to the bit. An interrupted training resumes from its snapshots
+(``smpl.snapshots``, in the cache file's ``.partial`` folder).
+"""
+
+import contextlib
+import dataclasses
+import hashlib
+import pathlib
+
+from smpl import checkpoint
+from smpl import forward_model as smpl_forward
+from smpl import progress
+from smpl import snapshots
+from smpl import training
+from softbench import data
+from softbench import protocols
+from softbench import storage
+from softbench.robots import base as robot_base
+
+FOLDER = "forward"  # Under the data home.
+
+
+@dataclasses.dataclass(frozen=True)
+class ForwardModelConfig:
+  """Everything a cached forward model's weights depend on; its hash names the file."""
+
+  robot: str
+  robot_xml_sha256: str
+  view: str
+  samples: int
+  data_seed: int
+  seed: int
+  max_epochs: int
+  patience: int
+  compile: bool
+  training_version: int
+
+  @property
+  def key(self) -> str:
+    text = repr(dataclasses.astuple(self)).encode()
+    return (f"{self.robot}-{self.view}-seed{self.seed}-"
+            f"{hashlib.sha256(text).hexdigest()[:12]}")
+
+
+def cache_file(config: ForwardModelConfig) -> pathlib.Path:
+  """Where the forward model of ``config`` is cached (it exists once trained)."""
+  return storage.softbench_home() / FOLDER / f"{config.key}.pt"
+
+
+def prepare(robot: robot_base.SoftArm, views: list[data.View], dataset: data.Dataset,
+            samples: int, data_seed: int, config: training.ForwardTrainingConfig,
+            training_version: int, progress_label: str | None = None
+            ) -> tuple[list[data.SplitWindows], list[smpl_forward.ForwardModel]]:
+  """Each view's windows of ``dataset`` (``samples`` babbling samples of seed ``data_seed``) and
+  its frozen forward model trained with ``config``: from the cache, or trained now (with an epoch
+  progress bar named ``progress_label VIEW`` if given) and cached."""
+  xml_sha256 = hashlib.sha256(robot.to_xml().encode()).hexdigest()
+  windows, forwards = [], []
+  for view in views:
+    key = ForwardModelConfig(robot.name, xml_sha256, view.name, samples, data_seed, config.seed,
+                             config.max_epochs, config.patience, config.compile,
+                             training_version)
+    path = cache_file(key)
+    if path.exists():
+      split = data.windows(dataset, view)
+      model = smpl_forward.ForwardModel(split.train.actuation_size, split.train.pose_size)
+      checkpoint.load_checkpoint(path, model, key)
+      model.freeze()
+    else:
+      with snapshots.resumable(path.with_suffix(".partial")), (
+          progress.EpochProgressBar(f"{progress_label} {view.name}", config.max_epochs)
+          if progress_label else contextlib.nullcontext(None)) as bar:
+        column = protocols.prepare_column(robot, view, dataset, config,
+                                          training.default_device(), bar)
+      split, model = column.windows, column.forward_model
+      checkpoint.save_checkpoint(path, model, key)
+      snapshots.discard(path.with_suffix(".partial"))
+    windows.append(split)
+    forwards.append(model.eval())
+  return windows, forwards
