@@ -18,6 +18,7 @@ from smpl.training import (
     fit,
     forward_model_loss,
     inverse_model_loss,
+    train_forward_model,
     train_inverse_model,
 )
 from smpl.windows import BabblingWindows, inverse_input_size
@@ -239,6 +240,16 @@ def test_compiled_training_matches_eager_training(
         results[compile_] = [report.train_loss for report in result.history]
     assert not fallbacks, "torch.compile fell back to eager"
     assert results[True] == pytest.approx(results[False], rel=1e-3)
+
+
+def test_a_forward_model_with_compile_asked_trains_without_a_fallback_warning(
+    arm_data: dict[str, BabblingWindows]
+) -> None:
+    config = dataclasses.replace(ForwardTrainingConfig(), max_epochs=1, compile=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)  # "torch.compile failed" would raise.
+        train_forward_model(ForwardModel(actuation_size=2, hidden_size=8), arm_data["train"],
+                            arm_data["validation"], config, CPU)
 
 
 def test_validation_leaves_out_the_aux_loss(
