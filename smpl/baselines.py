@@ -148,6 +148,8 @@ class BiLSTMInverse(InverseModel):
     directions; `forward` does the same for every step of a sequence at once.
     """
 
+    compiles_on_cpu = False  # nn.LSTM's fused CPU kernel: see `ForwardModel.compiles_on_cpu`.
+
     def __init__(
         self,
         input_size: int,

@@ -25,6 +25,11 @@ class ForwardModel(nn.Module):
     with respect to its inputs so that inverse-model training can backpropagate through it.
     """
 
+    compiles_on_cpu = False
+    """Inductor (torch 2.13) cannot compile the CPU's fused nn.LSTM (`aten.mkldnn_rnn_layer`
+    fails with "expected Tensor()"), which this model runs over whole windows; `smpl.training.fit`
+    trains it eagerly on the CPU rather than fail, warn and fall back."""
+
     def __init__(
         self,
         actuation_size: int,

@@ -175,7 +175,6 @@ def fit(
     device: torch.device | None = None,
     on_epoch_end: Callable[[EpochReport], None] | None = None,
     validation_loss: BatchLoss | None = None,
-    compile_on_cpu: bool = True,
 ) -> TrainingResult:
     """Trains the trainable parameters of `model` to minimise `batch_loss` on `train`.
 
@@ -185,8 +184,8 @@ def fit(
     the model ends with the weights of its best epoch, in eval mode. The same config and data give
     the same weights. `batch_loss` must use tensors on the model's device: `fit` moves `model` and
     the windows there, nothing else. Inside `smpl.snapshots.resumable`, a stopped fit resumes
-    where it was (`on_epoch_end` then first gets the epochs already run). `compile_on_cpu=False`
-    trains eagerly on the CPU even when `config.compile` asks for Inductor.
+    where it was (`on_epoch_end` then first gets the epochs already run). A model whose
+    `compiles_on_cpu` is False trains eagerly on the CPU whatever `config.compile` says.
     """
     device = device if device is not None else default_device()
     parameters = [parameter for parameter in model.parameters() if parameter.requires_grad]
@@ -202,7 +201,7 @@ def fit(
             parameters, lr=config.learning_rate, weight_decay=config.weight_decay
         )
         train_loss_of, step = batch_loss, optimizer.step
-        if config.compile and (compile_on_cpu or device.type != "cpu"):
+        if config.compile and (device.type != "cpu" or getattr(model, "compiles_on_cpu", True)):
             train_loss_of, step = _compiled(batch_loss), _compiled(optimizer.step)
         run = _FitState(
             model,
@@ -370,13 +369,7 @@ def train_forward_model(
     device: torch.device | None = None,
     on_epoch_end: Callable[[EpochReport], None] | None = None,
 ) -> TrainingResult:
-    """Trains the forward model on babbling windows, then freezes it.
-
-    On the CPU it trains eagerly whatever `config.compile` says: the forward model runs nn.LSTM
-    over whole windows, and Inductor (torch 2.13) cannot compile the CPU's fused LSTM
-    (`aten.mkldnn_rnn_layer` fails with "expected Tensor()"), so compiling only cost a failed
-    attempt and a warning before the eager fallback.
-    """
+    """Trains the forward model on babbling windows, then freezes it."""
     result = fit(
         forward_model,
         lambda windows: forward_model_loss(forward_model, windows),
@@ -385,7 +378,6 @@ def train_forward_model(
         config,
         device,
         on_epoch_end,
-        compile_on_cpu=False,
     )
     forward_model.freeze()
     return result

@@ -6,7 +6,7 @@ import pytest
 import torch
 from rich.console import Console
 
-from smpl.baselines import VAELSTMInverse
+from smpl.baselines import BiLSTMInverse, LSTMInverse, MLPInverse, VAELSTMInverse
 from smpl.forward_model import ForwardModel
 from smpl.progress import EpochProgressBar
 from smpl.progressive import ProgressiveLSTM
@@ -242,12 +242,33 @@ def test_compiled_training_matches_eager_training(
     assert results[True] == pytest.approx(results[False], rel=1e-3)
 
 
-def test_a_forward_model_with_compile_asked_trains_without_a_fallback_warning(
+INVERSE_MODELS = {
+    "smpl-column": lambda: _fresh_column(),
+    **{cls.__name__: (lambda cls=cls: cls(inverse_input_size(6, 2), 2, hidden_size=8))
+       for cls in (MLPInverse, LSTMInverse, VAELSTMInverse, BiLSTMInverse)},
+}
+
+
+@pytest.mark.parametrize("name", INVERSE_MODELS)
+def test_every_model_compiles_or_says_it_cannot(
+    name: str, arm_data: dict[str, BabblingWindows], trained_forward_model: ForwardModel
+) -> None:
+    """With compile asked, a model compiles on the CPU if its `compiles_on_cpu` says it can, and
+    trains eagerly otherwise: never a failed compile, which warns before falling back."""
+    model = INVERSE_MODELS[name]()
+    config = dataclasses.replace(SHORT_RUN, max_epochs=1, compile=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)  # "torch.compile failed" would raise.
+        train_inverse_model(model, trained_forward_model, arm_data["train"],
+                            arm_data["validation"], config, CPU)
+
+
+def test_the_forward_model_trains_eagerly_on_the_cpu_without_a_warning(
     arm_data: dict[str, BabblingWindows]
 ) -> None:
     config = dataclasses.replace(ForwardTrainingConfig(), max_epochs=1, compile=True)
     with warnings.catch_warnings():
-        warnings.simplefilter("error", RuntimeWarning)  # "torch.compile failed" would raise.
+        warnings.simplefilter("error", RuntimeWarning)
         train_forward_model(ForwardModel(actuation_size=2, hidden_size=8), arm_data["train"],
                             arm_data["validation"], config, CPU)
 
