@@ -4,7 +4,7 @@ A forward model's weights depend on the robot, the view it predicts, the babblin
 training config (the paper's, seeded by the agent's seed), not on the inverse model trained
 through it. So the agents that read the same view with the same seed and profile (the four
 baselines' whole-arm model) and every trial of a tuning study share one: trained as
-``smpl.protocols``' ``prepare_column`` trains it, cached under ``$SOFTBENCH_HOME/forward`` by a
+``softbench.protocols.prepare_column`` trains it, cached under ``$SOFTBENCH_HOME/forward`` by a
 hash of everything its weights depend on (``ForwardModelConfig``), and loaded with the weights a
 fresh training gives, to the bit. An interrupted training resumes from its snapshots
 (``smpl.snapshots``, in the cache file's ``.partial`` folder).
@@ -69,20 +69,21 @@ def prepare(robot: robot_base.SoftArm, views: list[data.View], dataset: data.Dat
                              config.max_epochs, config.patience, config.compile,
                              training_version)
     path = cache_file(key)
+    partial = path.with_suffix(".partial")  # Its training snapshots until it is saved.
     if path.exists():
       split = data.windows(dataset, view)
       model = smpl_forward.ForwardModel(split.train.actuation_size, split.train.pose_size)
       checkpoint.load_checkpoint(path, model, key)
       model.freeze()
     else:
-      with snapshots.resumable(path.with_suffix(".partial")), (
+      with snapshots.resumable(partial), (
           progress.EpochProgressBar(f"{progress_label} {view.name}", config.max_epochs)
           if progress_label else contextlib.nullcontext(None)) as bar:
         column = protocols.prepare_column(robot, view, dataset, config,
                                           training.default_device(), bar)
       split, model = column.windows, column.forward_model
       checkpoint.save_checkpoint(path, model, key)
-      snapshots.discard(path.with_suffix(".partial"))
+      snapshots.discard(partial)
     windows.append(split)
     forwards.append(model.eval())
   return windows, forwards

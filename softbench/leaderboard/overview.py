@@ -1,9 +1,10 @@
 """Overview tables: every agent on every task of a robot at a glance, beside the paper's values.
 
 One table per robot, profile (paper first) and eval mode (physics first): agents by rows
-(registry order, then any others by name), the tasks that have a record by columns (suite order). A cell is the position error (mm)
-of the row that the task's ranking shows for that agent, profile and eval mode (its newest
-record): mean ± std over seeds of the episode's module-averaged error. Where the paper reports
+(registry order, then any others by name), the tasks that have a record by columns (suite
+order). A cell is the position error (mm) of the row that the task's ranking shows for that
+agent, profile and eval mode (its newest record): mean ± std over seeds of the episode's
+module-averaged error. Where the paper reports
 the same robot, task and agent (``paper_exp2.json``: Exp2S for tendon-3, Exp2R for
 pneumatic-433), the paper's mean follows in brackets. Only plain tasks count: a custom
 trajectory, a fault or an extra section is a different experiment.
@@ -81,7 +82,8 @@ def overviews(board: ranking.Leaderboard) -> tuple[Overview, ...]:
   tables = []
   for (robot, profile, eval_mode), estimates in cells.items():  # Already in the groups' order.
     tasks = sorted({task for _, task in estimates}, key=suite.TASKS.index)
-    names = sorted({agent for agent, _ in estimates}, key=lambda agent: _known_first(agent, agents.AGENTS))
+    names = sorted({agent for agent, _ in estimates},
+                   key=lambda agent: _known_first(agent, agents.AGENTS))
     experiment = paper()["experiments"].get(robot)
     caption = ("position error (mm), mean ± std over seeds of the module-averaged error; " +
                (f"in brackets the paper's {experiment['name']} mean" if experiment else
@@ -91,9 +93,9 @@ def overviews(board: ranking.Leaderboard) -> tuple[Overview, ...]:
                  for agent in names)
     tables.append(Overview(robot, profile, eval_mode,
                            Table(caption, ("agent", *tasks), rows, label_columns=1)))
-  return tuple(sorted(tables, key=lambda view: (ranking.robot_order(view.robot),
-                                                _known_first(view.profile, profiles.PROFILES),
-                                                _known_first(view.eval_mode, learned.ERROR_SOURCES))))
+  return tuple(sorted(tables, key=lambda view: (
+      ranking.robot_order(view.robot), _known_first(view.profile, profiles.PROFILES),
+      _known_first(view.eval_mode, learned.ERROR_SOURCES))))
 
 
 def about_paper() -> str:

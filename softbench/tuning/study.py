@@ -3,11 +3,12 @@
 Every learned agent gets the same study: its search space (``agents.hyperparameters``), the same
 number of trials, a seeded TPE sampler and a median pruner fed with per-epoch validation losses.
 A trial trains the agent's inverse model with the sampled values in closed loop through frozen
-forward models (trained once and shared, ``agents.forward_models``), on the profile's babbling dataset and
-with the study's seed, as ``softbench run`` trains the agent's seed (for at most ``epochs``
-epochs, the profile's unless a study asks for fewer to afford more trials); its value is the
-best validation loss: the action MSE over the whole arm on the validation split, in normalised
-units, the VAE's KL term left out (``learned.train_inverse``), the same quantity for every agent.
+forward models (trained once and shared, ``agents.forward_models``), on the profile's babbling
+dataset and with the study's seed, as ``softbench run`` trains the agent's seed (for at most
+``epochs`` epochs, the profile's unless a study asks for fewer to afford more trials); its value
+is the best validation loss: the action MSE over the whole arm on the validation split, in
+normalised units, the VAE's KL term left out (``learned.train_inverse``), the same quantity for
+every agent.
 
 The first trial is the agent's values in use when the study starts (``hyperparameters.json``),
 so each study measures the values it replaces on the same data. Studies live in an Optuna storage
