@@ -15,9 +15,6 @@ Every page (``text``, ``markdown_page``, ``html_page``) renders the same ``Table
 """
 
 import dataclasses
-import functools
-import importlib.resources
-import json
 import pathlib
 import re
 
@@ -25,6 +22,7 @@ from softbench import continual
 from softbench import metrics
 from softbench.leaderboard import exp1s_records
 from softbench.leaderboard.figure_table import Table
+from softbench.leaderboard import paper_tables
 from softbench.leaderboard import records
 from softbench.leaderboard import selection
 
@@ -35,12 +33,10 @@ LOOP_LABELS = {"closed": "closed loop (softbench: error measured in physics)",
                "open": "open loop (no error fed back)"}
 
 
-@functools.cache
 def paper() -> dict:
   """The paper's Exp1S table (``paper_exp1s.json``): source, note, robots and
   ``scores[loop][task][metric]``, one [mean, std] per configuration."""
-  text = importlib.resources.files(__package__).joinpath(PAPER_FILE).read_text(encoding="utf-8")
-  return json.loads(text)
+  return paper_tables.load(PAPER_FILE)
 
 
 def figure(mean: float, std: float) -> str:

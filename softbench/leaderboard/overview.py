@@ -11,9 +11,6 @@ trajectory, a fault or an extra section is a different experiment.
 """
 
 import dataclasses
-import functools
-import importlib.resources
-import json
 
 from softbench import agents
 from softbench import profiles
@@ -21,17 +18,16 @@ from softbench import suite
 from softbench.agents import learned
 from softbench.leaderboard import ranking
 from softbench.leaderboard.figure_table import Table
+from softbench.leaderboard import paper_tables
 
 PAPER_FILE = "paper_exp2.json"  # In this package; its "source" names the paper's tables.
 METRIC = "position_mm"
 
 
-@functools.cache
 def paper() -> dict:
   """The paper's Exp2S and Exp2R tables (``paper_exp2.json``): source, note and, per robot,
   ``experiments[robot]``: name, agents and ``scores[task][metric]``, one [mean, std] per agent."""
-  text = importlib.resources.files(__package__).joinpath(PAPER_FILE).read_text(encoding="utf-8")
-  return json.loads(text)
+  return paper_tables.load(PAPER_FILE)
 
 
 def paper_mean(robot: str, task: str, agent: str) -> float | None:
