@@ -246,6 +246,23 @@ def _add_video_arguments(parser: argparse.ArgumentParser) -> None:
                            "(default 1: the pose at the end of every step)")
 
 
+def _add_profile_argument(parser: argparse.ArgumentParser) -> None:
+  parser.add_argument("--profile", default=profiles.DEFAULT_PROFILE,
+                      help=f"one of {', '.join(profiles.PROFILES)} "
+                           f"(default {profiles.DEFAULT_PROFILE})")
+
+
+def _add_eval_argument(parser: argparse.ArgumentParser) -> None:
+  parser.add_argument("--eval", default="physics",
+                      help="physics (default), model or open-loop: the error fed back")
+
+
+def _add_record_arguments(parser: argparse.ArgumentParser) -> None:
+  parser.add_argument("--results", default="leaderboard/results",
+                      help="folder of the result records (default leaderboard/results)")
+  parser.add_argument("--json", help="also write the result record to this file")
+
+
 def _leaderboard(args: argparse.Namespace) -> None:
   results = pathlib.Path(args.results)
   board = leaderboard.build(results)
@@ -336,11 +353,8 @@ def build_parser() -> argparse.ArgumentParser:
   run_parser.add_argument("--robot", help="default: the task's robot in the paper (tendon-3; "
                                           "pneumatic-433 for reach)")
   run_parser.add_argument("--seeds", type=int, help="number of seeds (default: the profile's)")
-  run_parser.add_argument("--profile", default=profiles.DEFAULT_PROFILE,
-                          help=f"one of {', '.join(profiles.PROFILES)} "
-                               f"(default {profiles.DEFAULT_PROFILE})")
-  run_parser.add_argument("--eval", default="physics", help="physics (default), model or "
-                                                            "open-loop: the error fed back")
+  _add_profile_argument(run_parser)
+  _add_eval_argument(run_parser)
   run_parser.add_argument("--trajectory", help="target poses for --task custom (.npy or .csv)")
   run_parser.add_argument("--module", type=int,
                           help="the module that reaches (--task reach; default 2)")
@@ -353,9 +367,7 @@ def build_parser() -> argparse.ArgumentParser:
   run_parser.add_argument("--helpers", help="what --adaptive asks of the other active modules: "
                                             "share (default; the reaching module's error) or "
                                             "hold (their starting pose)")
-  run_parser.add_argument("--results", default="leaderboard/results",
-                          help="folder of the result records (default leaderboard/results)")
-  run_parser.add_argument("--json", help="also write the result record to this file")
+  _add_record_arguments(run_parser)
   run_parser.add_argument("--video", help="also render seed 0's episode to this .mp4 file")
   _add_video_arguments(run_parser)
   run_parser.add_argument("--fault", action="append", default=[],
@@ -384,11 +396,8 @@ def build_parser() -> argparse.ArgumentParser:
   render_parser.add_argument("--robot", help="default: the task's robot in the paper")
   render_parser.add_argument("--out", required=True, help="the video file (.mp4)")
   render_parser.add_argument("--seed", default="0", help="agent and environment seed (default 0)")
-  render_parser.add_argument("--profile", default=profiles.DEFAULT_PROFILE,
-                             help=f"one of {', '.join(profiles.PROFILES)} "
-                                  f"(default {profiles.DEFAULT_PROFILE})")
-  render_parser.add_argument("--eval", default="physics", help="physics (default), model or "
-                                                               "open-loop: the error fed back")
+  _add_profile_argument(render_parser)
+  _add_eval_argument(render_parser)
   render_parser.add_argument("--trajectory", help="target poses for --task custom (.npy or .csv)")
   _add_video_arguments(render_parser)
   render_parser.set_defaults(run=_render)
@@ -409,12 +418,8 @@ def build_parser() -> argparse.ArgumentParser:
                               help=f"centralised baseline retrained from scratch (default "
                                    f"{retrain_module.DEFAULT_BASELINE})")
   retrain_parser.add_argument("--seeds", type=int, help="number of seeds (default: the profile's)")
-  retrain_parser.add_argument("--profile", default=profiles.DEFAULT_PROFILE,
-                              help=f"one of {', '.join(profiles.PROFILES)} "
-                                   f"(default {profiles.DEFAULT_PROFILE})")
-  retrain_parser.add_argument("--results", default="leaderboard/results",
-                              help="folder of the result records (default leaderboard/results)")
-  retrain_parser.add_argument("--json", help="also write the result record to this file")
+  _add_profile_argument(retrain_parser)
+  _add_record_arguments(retrain_parser)
   retrain_parser.set_defaults(run=_retrain)
   models = commands.add_parser("models", help="exported MJCF models")
   models_commands = models.add_subparsers(dest="models_command", required=True)
