@@ -79,6 +79,9 @@ def test_cameras_frame_every_point(camera, aspect):
   assert share.max() > 0.7
 
 
+UNIFORM_FONT = [10] * 127  # (pixels) A font whose every character is 10 pixels wide.
+
+
 def test_markers_draw_the_trail_the_target_and_the_path_so_far():
   source = recorded(length=5)
   model = scene.scene_model(source.robot, scene.episode_points(source.episode), 64, 48)
@@ -112,7 +115,30 @@ def test_long_trails_and_paths_are_subsampled(monkeypatch):
   drawn(None, view)
   # Per module: 3 trail markers, the target, and the path start -> step 3 -> step 5.
   assert view.ngeom == 2 * (3 + 1 + 2) <= drawn.geom_count
-  assert drawn.caption(480) and not drawn.caption(48)
+  assert drawn.caption(480, 640, UNIFORM_FONT) and not drawn.caption(48, 64, UNIFORM_FONT)
+
+
+@pytest.mark.parametrize("width,legend", [(320, False), (480, None), (640, None), (1280, True)])
+def test_caption_fits_the_frame_width(width, legend):
+  """The caption's boxes stay inside the frame and apart; None: legend kept only if it fits."""
+  source = recorded(length=5)
+  model = scene.scene_model(source.robot, scene.episode_points(source.episode), 64, 48)
+  title = "reference on spiral (tendon-3) seed 0, paper profile"
+  drawn = markers.EpisodeMarkers(source.episode, scene.module_colours(model, 2),
+                                 source.robot.length, scene.arm_radius(model), title)
+  drawn.at(5.0, source.episode.poses[5, :, :3])
+  caption = {overlay.position: overlay for overlay in drawn.caption(360, width, UNIFORM_FONT)}
+  top = caption[mujoco.mjtGridPos.mjGRID_TOPLEFT]
+  assert top.title.split() == title.split()  # Every word, wrapped between words only.
+  assert all(markers.overlay_width(line, "", UNIFORM_FONT) <= width
+             for line in top.title.split("\n"))
+  bottom = [caption[position] for position in (mujoco.mjtGridPos.mjGRID_BOTTOMLEFT,
+                                               mujoco.mjtGridPos.mjGRID_BOTTOMRIGHT)
+            if position in caption]
+  assert sum(markers.overlay_width(overlay.title, overlay.body, UNIFORM_FONT)
+             for overlay in bottom) <= width
+  if legend is not None:
+    assert (len(bottom) == 2) == legend
 
 
 def test_replay_reproduces_the_episode_and_refuses_another_seed():

@@ -45,6 +45,7 @@ class EpisodeFrames:
     for time, simulated in episode_replay.moments(self.replay, self.options.frames_per_step):
       scene.show_state(self.physics.model.ptr, self.physics.data.ptr, simulated.data.ptr)
       self.markers.at(time, simulated.module_poses()[self._scored, :3])
-      image = self._camera.render(overlays=self.markers.caption(self.options.height),
-                                  scene_option=self._view)
+      caption = self.markers.caption(self.options.height, self.options.width,
+                                     self.physics.contexts.mujoco.ptr.charWidth)
+      image = self._camera.render(overlays=caption, scene_option=self._view)
       yield image.copy()  # The camera reuses its buffer for the next frame.

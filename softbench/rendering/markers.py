@@ -7,6 +7,8 @@ markers and about ``MAX_PATH_SEGMENTS`` path segments per module (the path throu
 step, the same steps in every frame, so that it does not shimmer as it grows).
 """
 
+from collections.abc import Sequence
+
 import mujoco
 import numpy as np
 from dm_control.mujoco import engine
@@ -22,12 +24,41 @@ TARGET_ARM_SHARE = 0.5  # this share of the arm's drawn radius if larger (thick 
 PATH_RADIUS = 0.005  # Achieved-path capsule radius, in arm lengths.
 TRAIL_ALPHA = 0.55
 MIN_CAPTION_HEIGHT = 240  # (pixels) Smaller frames get no caption, which would cover them.
+# Layout of mjr_overlay's text boxes, measured at dm_control's font scale (150): a box reaches
+# OVERLAY_EDGE_PX plus its text's width in from the frame's edge, and its two columns are
+# OVERLAY_GAP_PX apart.
+OVERLAY_EDGE_PX = 17
+OVERLAY_GAP_PX = 11
 _WHITE = np.ones(4)
 
 
 def _tint(colour: np.ndarray, towards: np.ndarray, amount: float, alpha: float) -> np.ndarray:
   mixed = (1 - amount) * np.asarray(colour, float) + amount * towards
   return np.append(mixed[:3], alpha).astype(np.float32)
+
+
+def _text_width(text: str, char_widths: Sequence[int]) -> int:
+  """Pixel width of the widest line of ``text`` (ASCII) in a font of ``char_widths``."""
+  return max(sum(char_widths[min(ord(char), len(char_widths) - 1)] for char in line)
+             for line in text.split("\n"))
+
+
+def overlay_width(labels: str, values: str, char_widths: Sequence[int]) -> int:
+  """How far (pixels) a text overlay of ``labels`` and ``values`` reaches in from its edge."""
+  width = OVERLAY_EDGE_PX + _text_width(labels, char_widths)
+  return width + (OVERLAY_GAP_PX + _text_width(values, char_widths) if values else 0)
+
+
+def _wrap(text: str, width: int, char_widths: Sequence[int]) -> str:
+  """``text`` broken between words into lines whose overlays fit in ``width`` pixels (a word
+  longer than that keeps a line of its own)."""
+  lines = []
+  for word in text.split():
+    if lines and overlay_width(f"{lines[-1]} {word}", "", char_widths) <= width:
+      lines[-1] = f"{lines[-1]} {word}"
+    else:
+      lines.append(word)
+  return "\n".join(lines)
 
 
 def _subsample(count: int, limit: int) -> np.ndarray:
@@ -119,16 +150,25 @@ class EpisodeMarkers:
           mujoco.mjv_connector(geom, mujoco.mjtGeom.mjGEOM_CAPSULE, PATH_RADIUS * self._length,
                                start, end)
 
-  def caption(self, height: int) -> tuple[engine.TextOverlay, ...]:
-    """The title (top left), the step with the mean tip error of scored modules after it (bottom
-    right) and a legend (bottom left), for frames of ``height`` pixels (none if small)."""
+  def caption(self, height: int, width: int,
+              char_widths: Sequence[int]) -> tuple[engine.TextOverlay, ...]:
+    """The title (top left, wrapped to the frame's width), the step with the mean tip error of
+    the scored modules after it (bottom right) and, where it fits beside them, a legend (bottom
+    left), for frames of ``height`` x ``width`` pixels (none if small). ``char_widths``: pixel
+    width of each ASCII character in the overlay font (``MjrContext.charWidth``)."""
     if height < MIN_CAPTION_HEIGHT:
       return ()
     steps = len(self._errors_mm)
     done = int(np.floor(self._time + 1e-9))
     error = f"{self._errors_mm[done - 1].mean():.1f} mm" if done else "-"
-    return (engine.TextOverlay(self._title, "", style="normal", position="top left"),
-            engine.TextOverlay("step\nmean tip error", f"{done} of {steps}\n{error}",
-                               style="normal", position="bottom right"),
-            engine.TextOverlay("dots\nline", "target trail\nachieved tip path",
-                               style="normal", position="bottom left"))
+    status_labels = "step\nmean tip error"
+    widest_status = f"{steps} of {steps}\n{self._errors_mm.mean(axis=1).max():.1f} mm"
+    legend = ("dots\nline", "target\ntip path")
+    overlays = [engine.TextOverlay(_wrap(self._title, width, char_widths), "", style="normal",
+                                   position="top left"),
+                engine.TextOverlay(status_labels, f"{done} of {steps}\n{error}", style="normal",
+                                   position="bottom right")]
+    if (overlay_width(*legend, char_widths)
+        + overlay_width(status_labels, widest_status, char_widths) <= width):
+      overlays.append(engine.TextOverlay(*legend, style="normal", position="bottom left"))
+    return tuple(overlays)
