@@ -127,6 +127,18 @@ def test_reference_agent_does_not_depend_on_the_thread_count():
   np.testing.assert_array_equal(single.actions, reach_episode("reference", "tendon-3").actions)
 
 
+def test_reference_agent_forgets_its_restart_memory_between_episodes():
+  # Babbling restarts at almost every step, from remembered actions after the first restart.
+  def babbling_actions(agent, env_seed):
+    env = suite.load("tendon-3", "babbling", seed=env_seed, length=BABBLING_LENGTH)
+    return run_episode(agent, env, "babbling", BABBLING_STEPS).actions
+
+  used = agents.make("reference", "tendon-3")
+  babbling_actions(used, env_seed=1)
+  np.testing.assert_array_equal(babbling_actions(used, env_seed=0),
+                                babbling_actions(agents.make("reference", "tendon-3"), 0))
+
+
 @pytest.mark.parametrize("robot,task,options", [
     # Measured (mean normalised tip error, zero agent -> reference agent): tendon-2 circle
     # 21.2 % -> 0.0003 %, pneumatic-433 circle 15.6 % -> 0.012 %, tendon-3 reach (module 2)
