@@ -273,14 +273,24 @@ def _parallel(function, arguments: list[tuple], label: str, workers: int) -> lis
           break
       outcomes = [future.result() for future in pending]  # Re-raises a worker's error.
       progress.update(bar, completed=len(arguments))
-    return outcomes
   except futures.process.BrokenProcessPool:
+    _terminate(executor)
     raise WorkerDied(f"a worker process of {label} ended without a result (killed, or out of "
                      f"memory?); run the same command again to resume") from None
-  finally:
-    for process in multiprocessing.active_children():  # The executor's workers.
-      process.terminate()
-    executor.shutdown(wait=True, cancel_futures=True)
+  except BaseException:  # A worker's error, or Ctrl-C: the other workers stop at once.
+    _terminate(executor)
+    raise
+  # Idle workers exit on their own, so that their clean-up runs (terminating them would leak
+  # the semaphores of torch.compile's worker pools).
+  executor.shutdown(wait=True)
+  return outcomes
+
+
+def _terminate(executor: futures.ProcessPoolExecutor) -> None:
+  """Stops the executor's workers, busy or not, and waits for them."""
+  for process in multiprocessing.active_children():  # The executor's workers.
+    process.terminate()
+  executor.shutdown(wait=True, cancel_futures=True)
 
 
 def over_seeds(function, seeds: int, arguments: tuple, label: str, show_progress: bool,

@@ -70,3 +70,28 @@ def test_ctrl_c_or_kill_stops_every_worker(stop):
   process.send_signal(stop)
   out, _ = process.communicate(timeout=60)
   assert "children left: 0" in out
+
+
+_COMPILING_PROGRAM = """
+import sys
+sys.path.insert(0, {tests!r})
+from softbench import run
+import test_parallel_seeds
+print(run._parallel(test_parallel_seeds.compiled_double, [(1.0,), (2.0,)], "compiling", workers=2))
+"""
+
+
+def compiled_double(value):
+  import torch  # Only the workers pay for it.
+  return float(torch.compile(lambda tensor: 2 * tensor)(torch.tensor(value)))
+
+
+def test_finished_workers_exit_cleanly():
+  # Terminating idle workers left torch.compile's pool semaphores to the resource tracker, which
+  # warned "There appear to be 2 leaked semaphore objects" after every compiled training run.
+  program = _COMPILING_PROGRAM.format(tests=os.path.dirname(__file__))
+  result = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True,
+                          timeout=300)
+  assert result.returncode == 0, result.stderr
+  assert result.stdout.strip().endswith("[2.0, 4.0]")
+  assert "leaked" not in result.stderr, result.stderr
