@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
+import logging
 import math
 import time
 import warnings
@@ -487,8 +488,17 @@ def _train_epoch(
     return total.item() / len(train)
 
 
+def _is_not_profiler_notice(record: logging.LogRecord) -> bool:
+    """False for Dynamo's notice that it skips the optimisers' `record_function` profiler
+    markers (harmless, and printed once by every worker process that compiles a step)."""
+    return not record.getMessage().startswith("Profiler record function")
+
+
 def _compiled(function: Callable) -> Callable:
     """`torch.compile(function)`, or `function` itself (with a warning) if compiling fails."""
+    notices = logging.getLogger("torch._dynamo.variables.ctx_manager")
+    if _is_not_profiler_notice not in notices.filters:
+        notices.addFilter(_is_not_profiler_notice)
     # The LSTM layers run through torch.lstm_cell with nn.LSTM's weights; Dynamo refuses to touch
     # nn.LSTM modules unless told that this is fine.
     torch._dynamo.config.allow_rnn = True

@@ -1,5 +1,6 @@
 import dataclasses
 import io
+import logging
 import warnings
 
 import pytest
@@ -21,6 +22,7 @@ from smpl.training import (
     train_forward_model,
     train_inverse_model,
 )
+from smpl import training
 from smpl.windows import BabblingWindows, inverse_input_size
 
 CPU = torch.device("cpu")
@@ -241,6 +243,24 @@ def test_compiled_training_matches_eager_training(
     assert not fallbacks, "torch.compile fell back to eager"
     assert results[True] == pytest.approx(results[False], rel=1e-3)
 
+
+
+def test_a_compiled_optimiser_step_prints_no_profiler_notice() -> None:
+    """Dynamo skips the optimisers' profiler markers and says so once per process, a line that
+    every worker of a compiled run printed; training filters it out."""
+    torch._logging._internal.warning_once.cache_clear()  # Said already in this process?
+    logger = logging.getLogger("torch._dynamo.variables.ctx_manager")
+    said = io.StringIO()
+    handler = logging.StreamHandler(said)  # Sees what passes the logger's own filters.
+    logger.addHandler(handler)
+    try:
+        model = torch.nn.Linear(3, 1)
+        optimizer = torch.optim.Adam(model.parameters())
+        model(torch.ones(3)).sum().backward()
+        training._compiled(optimizer.step)()
+    finally:
+        logger.removeHandler(handler)
+    assert "Profiler record function" not in said.getvalue()
 
 INVERSE_MODELS = {
     "smpl-column": lambda: _fresh_column(),
