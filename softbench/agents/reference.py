@@ -37,11 +37,11 @@ the agent may stop a few mm from a reach target.
 Cost on a 2-core CPU: about 0.1 s per control step of tendon-3 (a 1000-step tracking episode in
 about 2 minutes), 0.05 s on pneumatic-433; a control period of tendon-5 is 3x dearer to simulate.
 Restarting makes a step dearer: on babbling's first 40 steps, with the 2 cores to itself,
-0.63 s per step on tendon-3 and 0.29 s on pneumatic-433 (0.1 s to 0.3 s of which is the local
-search that failed). Remembered candidates instead of the 64 samples at every restart cut this
-from 1.15 s and 0.43 s at the same accuracy: on 200 pneumatic-433 and 150 tendon-3 steps
-scored from the states of babbling's own path (where the generating action reaches the target
-exactly), 54 and 13 steps missed by more than 0.1 mm, against 55 and 15 with the samples.
+0.63 s per step on tendon-3 and 0.29 s on pneumatic-433. Remembered candidates instead of the
+64 samples at every restart cut this from 1.15 s and 0.43 s at the same accuracy: on 200
+pneumatic-433 and 150 tendon-3 steps scored from the states of babbling's own path (where the
+generating action reaches the target exactly), 54 and 13 steps missed by more than 0.1 mm,
+against 55 and 15 with the samples.
 """
 
 import copy
