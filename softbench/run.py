@@ -24,6 +24,7 @@ import pathlib
 import platform
 import signal
 import subprocess
+import sys
 import threading
 import time
 import warnings
@@ -35,6 +36,7 @@ import softbench
 from softbench import adaptive as adaptive_activation
 from softbench import agents
 from softbench import data
+from softbench import episode_snapshots
 from softbench import evaluation
 from softbench import metrics
 from softbench import profiles
@@ -208,10 +210,20 @@ def _episode_and_arm(run: RunSettings, seed: int, show_progress: bool
   return episode_on(agent, faulty, run, seed, show_progress), faulty
 
 
+def _device() -> str:
+  return str(learned.training.default_device())
+
+
 def _run_seed(seed: int, run: RunSettings,
               show_progress: bool) -> tuple[dict, evaluation.Episode]:
-  """The episode of ``seed`` (``seed_episode``) and its record entry."""
-  episode, arm = _episode_and_arm(run, seed, show_progress)
+  """The episode of ``seed`` (``seed_episode``, or the one an interrupted run of the same
+  settings and code saved) and its record entry; a new episode is saved at once."""
+  episode = episode_snapshots.load(run, _device(), seed)
+  if episode is None:
+    episode, arm = _episode_and_arm(run, seed, show_progress)
+    episode_snapshots.save(run, _device(), seed, episode)
+  else:
+    arm = robots.make(run.robot).with_faults(run.faults)
   return seed_entry(seed, episode, arm), episode
 
 
@@ -333,8 +345,13 @@ def execute_episodes(run: RunSettings, show_progress: bool = True, workers: int 
     results = {"scored_modules": [section["target_module"]], "per_seed": [],
                "adaptive": section}
   else:
+    saved = sorted(episode_snapshots.folder(run, _device()).glob("seed*.npz"))
+    if saved and show_progress:
+      print(f"resuming: {len(saved)} of {run.seeds} seeds finished before the run was "
+            f"interrupted", file=sys.stderr)
     outcomes = over_seeds(_run_seed, run.seeds, (run,), f"{run.agent} on {run.task}",
                           show_progress, workers)
+    episode_snapshots.discard(run, _device())
     results = {"scored_modules": list(outcomes[0][1].scored_modules),
                "per_seed": [entry for entry, _ in outcomes]}
   record = {

@@ -1,0 +1,88 @@
+"""The finished seeds of an interrupted ``softbench run``, so that the same command resumes.
+
+A seed's episode is saved (atomically, with a hash of its arrays) as soon as it ends, under
+``softbench_home()/runs/<agent>-<robot>-<task>-<key>/``. The key hashes the run's settings, the
+source of ``softbench`` and ``smpl``, the MuJoCo and torch versions and the training device, so
+that a changed setting or changed code never reuses an episode. The folder is removed once every
+seed has run, so a finished command run again evaluates afresh.
+"""
+
+import dataclasses
+import functools
+import hashlib
+import pathlib
+import shutil
+import warnings
+
+import mujoco
+import numpy as np
+import torch
+
+import smpl
+import softbench
+from softbench import evaluation
+from softbench import storage
+
+FOLDER = "runs"
+_ARRAYS = ("targets", "achieved", "poses", "actions", "rewards")
+_SOURCE_SUFFIXES = (".py", ".json")
+
+
+@functools.lru_cache(maxsize=None)
+def source_sha256() -> str:
+  """A hash of every source file of the ``softbench`` and ``smpl`` packages (names and bytes)."""
+  digest = hashlib.sha256()
+  for package in (softbench, smpl):
+    root = pathlib.Path(package.__file__).parent
+    for path in sorted(root.rglob("*")):
+      if path.suffix in _SOURCE_SUFFIXES and "__pycache__" not in path.parts:
+        digest.update(f"{package.__name__}/{path.relative_to(root).as_posix()}|".encode())
+        digest.update(path.read_bytes())
+  return digest.hexdigest()
+
+
+def folder(run, device: str) -> pathlib.Path:
+  """Where the finished seeds of ``run`` (a ``softbench.run.RunSettings``) are kept."""
+  identity = repr((dataclasses.asdict(run), source_sha256(), mujoco.__version__,
+                   torch.__version__, device))
+  key = hashlib.sha256(identity.encode()).hexdigest()[:16]
+  return storage.softbench_home() / FOLDER / f"{run.agent}-{run.robot}-{run.task}-{key}"
+
+
+def _path(run, device: str, seed: int) -> pathlib.Path:
+  return folder(run, device) / f"seed{seed}.npz"
+
+
+def save(run, device: str, seed: int, episode: evaluation.Episode) -> None:
+  """Keeps ``seed``'s finished ``episode`` until the run ends."""
+  arrays = {name: np.asarray(getattr(episode, name)) for name in _ARRAYS}
+  arrays["scored_modules"] = np.asarray(episode.scored_modules, dtype=int)
+  arrays["sha256"] = np.asarray(storage.arrays_sha256(arrays))
+  storage.write_atomically(_path(run, device, seed), storage.npz_bytes(arrays))
+
+
+def load(run, device: str, seed: int) -> evaluation.Episode | None:
+  """``seed``'s episode saved by an interrupted run of the same settings and code, or None. An
+  unreadable or altered file is deleted with a warning (the seed then runs again)."""
+  path = _path(run, device, seed)
+  if not path.exists():
+    return None
+  try:
+    with np.load(path) as file:
+      arrays = {name: file[name] for name in file.files}
+    expected = str(arrays.pop("sha256"))
+    if expected != storage.arrays_sha256(arrays):
+      raise ValueError("content hash mismatch")
+    episode = evaluation.Episode(run.task, tuple(int(k) for k in arrays["scored_modules"]),
+                                 *(arrays[name] for name in _ARRAYS))
+  except Exception as error:  # Truncated, corrupt or altered: run the seed again.
+    warnings.warn(f"discarding the saved episode {path} ({type(error).__name__}: {error}); "
+                  f"seed {seed} runs again")
+    path.unlink(missing_ok=True)
+    return None
+  return episode
+
+
+def discard(run, device: str) -> None:
+  """Removes the finished seeds of ``run`` once its record no longer needs them."""
+  shutil.rmtree(folder(run, device), ignore_errors=True)

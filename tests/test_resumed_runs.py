@@ -1,0 +1,78 @@
+"""An interrupted ``softbench run`` resumes: finished seeds are kept and not run again, with the
+same record as an uninterrupted run; a damaged saved seed runs again."""
+
+import pytest
+
+from softbench import episode_snapshots
+from softbench import run
+
+SEEDS = 3
+
+
+@pytest.fixture(autouse=True)
+def data_home(tmp_path, monkeypatch):
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
+
+
+def tiny_run(agent: str = "random") -> run.RunSettings:
+  return run.settings("circle", agent, "tendon-1", seeds=SEEDS, profile="tiny")
+
+
+def interrupted_at(seed: int, monkeypatch) -> list[int]:
+  """Runs tiny_run() until ``seed`` starts (raising KeyboardInterrupt there); the seeds run."""
+  started, episode_and_arm = [], run._episode_and_arm
+
+  def stop_at_seed(settings, index, show_progress):
+    started.append(index)
+    if index == seed:
+      raise KeyboardInterrupt
+    return episode_and_arm(settings, index, show_progress)
+
+  with monkeypatch.context() as patch:
+    patch.setattr(run, "_episode_and_arm", stop_at_seed)
+    with pytest.raises(KeyboardInterrupt):
+      run.execute(tiny_run(), show_progress=False, workers=1)
+  return started
+
+
+def seeds_run(monkeypatch) -> tuple[dict, list[int]]:
+  """A full run of tiny_run(): its record and the seeds it ran (rather than reloaded)."""
+  started, episode_and_arm = [], run._episode_and_arm
+
+  def counting(settings, index, show_progress):
+    started.append(index)
+    return episode_and_arm(settings, index, show_progress)
+
+  with monkeypatch.context() as patch:
+    patch.setattr(run, "_episode_and_arm", counting)
+    record = run.execute(tiny_run(), show_progress=False, workers=1)
+  return record, started
+
+
+def test_an_interrupted_run_resumes_from_its_finished_seeds(monkeypatch):
+  assert interrupted_at(2, monkeypatch) == [0, 1, 2]
+  resumed, started = seeds_run(monkeypatch)
+  assert started == [2]
+  assert not episode_snapshots.folder(tiny_run(), run._device()).exists()
+  fresh, started = seeds_run(monkeypatch)  # Finished: a new run evaluates afresh ...
+  assert started == [0, 1, 2]
+  assert resumed["per_seed"] == fresh["per_seed"]  # ... to the same scores.
+
+
+def test_a_damaged_saved_seed_runs_again(monkeypatch):
+  interrupted_at(1, monkeypatch)
+  saved = episode_snapshots.folder(tiny_run(), run._device()) / "seed0.npz"
+  saved.write_bytes(saved.read_bytes()[:-100])
+  with pytest.warns(UserWarning, match="discarding the saved episode"):
+    _, started = seeds_run(monkeypatch)
+  assert started == [0, 1, 2]
+
+
+def test_other_settings_never_reuse_saved_seeds():
+  folders = {episode_snapshots.folder(settings, "cpu") for settings in (
+      tiny_run(), tiny_run("zero"),
+      run.settings("circle", "random", "tendon-1", seeds=SEEDS, profile="tiny",
+                   eval_mode="open-loop"),
+      run.settings("circle", "random", "tendon-2", seeds=SEEDS, profile="tiny"))}
+  assert len(folders) == 4
+  assert episode_snapshots.folder(tiny_run(), "cuda") != episode_snapshots.folder(tiny_run(), "cpu")
