@@ -1,10 +1,11 @@
 """The finished seeds of an interrupted ``softbench run``, so that the same command resumes.
 
 A seed's episode is saved (atomically, with a hash of its arrays) as soon as it ends, under
-``softbench_home()/runs/<agent>-<robot>-<task>-<key>/``. The key hashes the run's settings, the
-source of ``softbench`` and ``smpl``, the MuJoCo and torch versions and the training device, so
-that a changed setting or changed code never reuses an episode. The folder is removed once every
-seed has run, so a finished command run again evaluates afresh.
+``softbench_home()/runs/<agent>-<robot>-<task>-<key>/``. The key hashes the run's settings (and
+a custom trajectory file's bytes), the source of ``softbench`` and ``smpl``, the MuJoCo and torch
+versions and the training device, so that a changed setting or changed code never reuses an
+episode. The folder is removed once every seed has run, so a finished command run again
+evaluates afresh.
 """
 
 import dataclasses
@@ -43,7 +44,9 @@ def source_sha256() -> str:
 
 def folder(run, device: str) -> pathlib.Path:
   """Where the finished seeds of ``run`` (a ``softbench.run.RunSettings``) are kept."""
-  identity = repr((dataclasses.asdict(run), source_sha256(), mujoco.__version__,
+  trajectory = (hashlib.sha256(pathlib.Path(run.trajectory).read_bytes()).hexdigest()
+                if run.trajectory else None)  # A file edited under the same name differs.
+  identity = repr((dataclasses.asdict(run), trajectory, source_sha256(), mujoco.__version__,
                    torch.__version__, device))
   key = hashlib.sha256(identity.encode()).hexdigest()[:16]
   return storage.softbench_home() / FOLDER / f"{run.agent}-{run.robot}-{run.task}-{key}"

@@ -1,6 +1,8 @@
 """An interrupted ``softbench run`` resumes: finished seeds are kept and not run again, with the
 same record as an uninterrupted run; a damaged saved seed runs again."""
 
+import dataclasses
+
 import pytest
 
 from softbench import episode_snapshots
@@ -76,3 +78,12 @@ def test_other_settings_never_reuse_saved_seeds():
       run.settings("circle", "random", "tendon-2", seeds=SEEDS, profile="tiny"))}
   assert len(folders) == 4
   assert episode_snapshots.folder(tiny_run(), "cuda") != episode_snapshots.folder(tiny_run(), "cpu")
+
+
+def test_an_edited_trajectory_file_never_reuses_saved_seeds(tmp_path):
+  path = tmp_path / "path.csv"
+  path.write_text("0.0,0.0,-0.05\n")
+  custom = dataclasses.replace(tiny_run(), task="custom", trajectory=str(path))
+  before = episode_snapshots.folder(custom, "cpu")
+  path.write_text("0.0,0.01,-0.05\n")
+  assert episode_snapshots.folder(custom, "cpu") != before
