@@ -44,8 +44,12 @@ def source_sha256() -> str:
 
 def folder(run, device: str) -> pathlib.Path:
   """Where the finished seeds of ``run`` (a ``softbench.run.RunSettings``) are kept."""
-  trajectory = (hashlib.sha256(pathlib.Path(run.trajectory).read_bytes()).hexdigest()
-                if run.trajectory else None)  # A file edited under the same name differs.
+  trajectory = None  # A file edited under the same name differs; an unreadable one fails later,
+  if run.trajectory:  # with its own error.
+    try:
+      trajectory = hashlib.sha256(pathlib.Path(run.trajectory).read_bytes()).hexdigest()
+    except OSError:
+      pass
   identity = repr((dataclasses.asdict(run), trajectory, source_sha256(), mujoco.__version__,
                    torch.__version__, device))
   key = hashlib.sha256(identity.encode()).hexdigest()[:16]
