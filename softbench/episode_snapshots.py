@@ -21,6 +21,7 @@ import torch
 
 import smpl
 import softbench
+from smpl import training
 from softbench import evaluation
 from softbench import storage
 
@@ -42,7 +43,12 @@ def source_sha256() -> str:
   return digest.hexdigest()
 
 
-def folder(run, device: str) -> pathlib.Path:
+def _device() -> str:
+  """The device the run's agents train on (``smpl.training.default_device``)."""
+  return str(training.default_device())
+
+
+def folder(run) -> pathlib.Path:
   """Where the finished seeds of ``run`` (a ``softbench.run.RunSettings``) are kept."""
   trajectory = None  # A file edited under the same name differs; an unreadable one fails later,
   if run.trajectory:  # with its own error.
@@ -51,27 +57,27 @@ def folder(run, device: str) -> pathlib.Path:
     except OSError:
       pass
   identity = repr((dataclasses.asdict(run), trajectory, source_sha256(), mujoco.__version__,
-                   torch.__version__, device))
+                   torch.__version__, _device()))
   key = hashlib.sha256(identity.encode()).hexdigest()[:16]
   return storage.softbench_home() / FOLDER / f"{run.agent}-{run.robot}-{run.task}-{key}"
 
 
-def _path(run, device: str, seed: int) -> pathlib.Path:
-  return folder(run, device) / f"seed{seed}.npz"
+def _path(run, seed: int) -> pathlib.Path:
+  return folder(run) / f"seed{seed}.npz"
 
 
-def save(run, device: str, seed: int, episode: evaluation.Episode) -> None:
+def save(run, seed: int, episode: evaluation.Episode) -> None:
   """Keeps ``seed``'s finished ``episode`` until the run ends."""
   arrays = {name: np.asarray(getattr(episode, name)) for name in _ARRAYS}
   arrays["scored_modules"] = np.asarray(episode.scored_modules, dtype=int)
   arrays["sha256"] = np.asarray(storage.arrays_sha256(arrays))
-  storage.write_atomically(_path(run, device, seed), storage.npz_bytes(arrays))
+  storage.write_atomically(_path(run, seed), storage.npz_bytes(arrays))
 
 
-def load(run, device: str, seed: int) -> evaluation.Episode | None:
+def load(run, seed: int) -> evaluation.Episode | None:
   """``seed``'s episode saved by an interrupted run of the same settings and code, or None. An
   unreadable or altered file is deleted with a warning (the seed then runs again)."""
-  path = _path(run, device, seed)
+  path = _path(run, seed)
   if not path.exists():
     return None
   try:
@@ -90,6 +96,6 @@ def load(run, device: str, seed: int) -> evaluation.Episode | None:
   return episode
 
 
-def discard(run, device: str) -> None:
+def discard(run) -> None:
   """Removes the finished seeds of ``run`` once its record no longer needs them."""
-  shutil.rmtree(folder(run, device), ignore_errors=True)
+  shutil.rmtree(folder(run), ignore_errors=True)

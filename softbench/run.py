@@ -210,18 +210,14 @@ def _episode_and_arm(run: RunSettings, seed: int, show_progress: bool
   return episode_on(agent, faulty, run, seed, show_progress), faulty
 
 
-def _device() -> str:
-  return str(learned.training.default_device())
-
-
 def _run_seed(seed: int, run: RunSettings,
               show_progress: bool) -> tuple[dict, evaluation.Episode]:
   """The episode of ``seed`` (``seed_episode``, or the one an interrupted run of the same
   settings and code saved) and its record entry; a new episode is saved at once."""
-  episode = episode_snapshots.load(run, _device(), seed)
+  episode = episode_snapshots.load(run, seed)
   if episode is None:
     episode, arm = _episode_and_arm(run, seed, show_progress)
-    episode_snapshots.save(run, _device(), seed, episode)
+    episode_snapshots.save(run, seed, episode)
   else:
     arm = robots.make(run.robot).with_faults(run.faults)
   return seed_entry(seed, episode, arm), episode
@@ -345,13 +341,13 @@ def execute_episodes(run: RunSettings, show_progress: bool = True, workers: int 
     results = {"scored_modules": [section["target_module"]], "per_seed": [],
                "adaptive": section}
   else:
-    saved = sorted(episode_snapshots.folder(run, _device()).glob("seed*.npz"))
+    saved = len(list(episode_snapshots.folder(run).glob("seed*.npz")))
     if saved and show_progress:
-      print(f"resuming: {len(saved)} of {run.seeds} seeds finished before the run was "
+      print(f"resuming: {saved} of {run.seeds} seeds finished before the run was "
             f"interrupted", file=sys.stderr)
     outcomes = over_seeds(_run_seed, run.seeds, (run,), f"{run.agent} on {run.task}",
                           show_progress, workers)
-    episode_snapshots.discard(run, _device())
+    episode_snapshots.discard(run)
     results = {"scored_modules": list(outcomes[0][1].scored_modules),
                "per_seed": [entry for entry, _ in outcomes]}
   record = {

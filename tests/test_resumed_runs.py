@@ -55,7 +55,7 @@ def test_an_interrupted_run_resumes_from_its_finished_seeds(monkeypatch):
   assert interrupted_at(2, monkeypatch) == [0, 1, 2]
   resumed, started = seeds_run(monkeypatch)
   assert started == [2]
-  assert not episode_snapshots.folder(tiny_run(), run._device()).exists()
+  assert not episode_snapshots.folder(tiny_run()).exists()
   fresh, started = seeds_run(monkeypatch)  # Finished: a new run evaluates afresh ...
   assert started == [0, 1, 2]
   assert resumed["per_seed"] == fresh["per_seed"]  # ... to the same scores.
@@ -63,27 +63,28 @@ def test_an_interrupted_run_resumes_from_its_finished_seeds(monkeypatch):
 
 def test_a_damaged_saved_seed_runs_again(monkeypatch):
   interrupted_at(1, monkeypatch)
-  saved = episode_snapshots.folder(tiny_run(), run._device()) / "seed0.npz"
+  saved = episode_snapshots.folder(tiny_run()) / "seed0.npz"
   saved.write_bytes(saved.read_bytes()[:-100])
   with pytest.warns(UserWarning, match="discarding the saved episode"):
     _, started = seeds_run(monkeypatch)
   assert started == [0, 1, 2]
 
 
-def test_other_settings_never_reuse_saved_seeds():
-  folders = {episode_snapshots.folder(settings, "cpu") for settings in (
+def test_other_settings_never_reuse_saved_seeds(monkeypatch):
+  folders = {episode_snapshots.folder(settings) for settings in (
       tiny_run(), tiny_run("zero"),
       run.settings("circle", "random", "tendon-1", seeds=SEEDS, profile="tiny",
                    eval_mode="open-loop"),
       run.settings("circle", "random", "tendon-2", seeds=SEEDS, profile="tiny"))}
   assert len(folders) == 4
-  assert episode_snapshots.folder(tiny_run(), "cuda") != episode_snapshots.folder(tiny_run(), "cpu")
+  monkeypatch.setattr(episode_snapshots, "_device", lambda: "cuda")  # Another device.
+  assert episode_snapshots.folder(tiny_run()) not in folders
 
 
 def test_an_edited_trajectory_file_never_reuses_saved_seeds(tmp_path):
   path = tmp_path / "path.csv"
   path.write_text("0.0,0.0,-0.05\n")
   custom = dataclasses.replace(tiny_run(), task="custom", trajectory=str(path))
-  before = episode_snapshots.folder(custom, "cpu")
+  before = episode_snapshots.folder(custom)
   path.write_text("0.0,0.01,-0.05\n")
-  assert episode_snapshots.folder(custom, "cpu") != before
+  assert episode_snapshots.folder(custom) != before
