@@ -67,11 +67,18 @@ def _path(run, seed: int) -> pathlib.Path:
 
 
 def save(run, seed: int, episode: evaluation.Episode) -> None:
-  """Keeps ``seed``'s finished ``episode`` until the run ends."""
+  """Keeps ``seed``'s finished ``episode`` until the run ends. A failed write (a full disk, or
+  an identical run elsewhere removing the folder as it ends) only warns: the run goes on, and
+  an interrupted one would run the seed again."""
   arrays = {name: np.asarray(getattr(episode, name)) for name in _ARRAYS}
   arrays["scored_modules"] = np.asarray(episode.scored_modules, dtype=int)
   arrays["sha256"] = np.asarray(storage.arrays_sha256(arrays))
-  storage.write_atomically(_path(run, seed), storage.npz_bytes(arrays))
+  path = _path(run, seed)
+  try:
+    storage.write_atomically(path, storage.npz_bytes(arrays))
+  except OSError as error:
+    warnings.warn(f"could not keep seed {seed}'s episode at {path} ({error.strerror or error}); "
+                  "the run goes on without it")
 
 
 def load(run, seed: int) -> evaluation.Episode | None:

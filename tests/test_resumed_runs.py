@@ -70,6 +70,19 @@ def test_a_damaged_saved_seed_runs_again(monkeypatch):
   assert started == [0, 1, 2]
 
 
+def test_a_failed_save_warns_and_the_run_goes_on(monkeypatch):
+  expected, _ = seeds_run(monkeypatch)
+
+  def disk_full(path, content):
+    raise OSError(28, "No space left on device")
+
+  monkeypatch.setattr(episode_snapshots.storage, "write_atomically", disk_full)
+  with pytest.warns(UserWarning, match="No space left on device.*the run goes on"):
+    record, started = seeds_run(monkeypatch)
+  assert started == [0, 1, 2]
+  assert record["per_seed"] == expected["per_seed"]
+
+
 def test_other_settings_never_reuse_saved_seeds(monkeypatch):
   folders = {episode_snapshots.folder(settings) for settings in (
       tiny_run(), tiny_run("zero"),
