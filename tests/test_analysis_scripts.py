@@ -1,0 +1,53 @@
+"""The scripts behind README figures (docs/analysis) keep running against the current API, on tiny
+data; the early-stopping script's best-validation agent is the one `softbench run` trains."""
+
+import importlib.util
+import pathlib
+import re
+import sys
+
+import pytest
+
+from softbench import data
+from softbench import run
+
+ANALYSIS = pathlib.Path(__file__).parent.parent / "docs" / "analysis"
+
+
+@pytest.fixture(autouse=True)
+def data_home(tmp_path, monkeypatch):
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
+
+
+def run_script(name: str, arguments: list[str], monkeypatch, capsys) -> str:
+  """Runs docs/analysis/NAME.py's main() with these arguments; returns what it printed."""
+  spec = importlib.util.spec_from_file_location(name, ANALYSIS / f"{name}.py")
+  module = importlib.util.module_from_spec(spec)
+  spec.loader.exec_module(module)
+  monkeypatch.setattr(sys, "argv", [name, *arguments])
+  module.main()
+  return capsys.readouterr().out
+
+
+def test_action_identifiability_reports_every_module_in_both_views(monkeypatch, capsys):
+  data.collect("tendon-2", samples=200, seed=0, progress=False)
+  out = run_script("action_identifiability", ["tendon-2", "--samples", "200"], monkeypatch,
+                   capsys)
+  for split in data.SPLITS:
+    assert re.search(rf"^  {split} +tip mean", out, re.MULTILINE)
+  assert re.findall(r"^  module (\d): residual variance", out, re.MULTILINE) == ["1", "2"]
+  assert re.findall(r"to module (\d)'s actions \(SMPL's column", out) == ["1", "2"]
+  fractions = re.search(r"fraction of variance left +\[([^\]]+)\]", out).group(1).split()
+  assert len(fractions) == 4 and all(float(value) >= 0.0 for value in fractions)
+
+
+def test_early_stopping_keeps_the_agent_softbench_run_trains(monkeypatch, capsys):
+  out = run_script("early_stopping", ["--agent", "lstm", "--robot", "tendon-1", "--task",
+                                      "circle", "--profile", "tiny", "--epochs", "2", "--keep",
+                                      "1", "2"], monkeypatch, capsys)
+  scores = dict(re.findall(r"seed 0, (best validation|after epoch \d)[^:]*: position error "
+                           r"([0-9.]+) mm", out))
+  assert set(scores) == {"best validation", "after epoch 1", "after epoch 2"}
+  record = run.execute(run.settings("circle", "lstm", "tendon-1", seeds=1, profile="tiny"),
+                       show_progress=False, workers=1)
+  assert scores["best validation"] == f"{record['per_seed'][0]['position_mm']['mean']:.2f}"
