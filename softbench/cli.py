@@ -1,5 +1,5 @@
 """The ``softbench`` command line. It parses arguments and calls the library; a bad input gets
-one line on stderr and exit code 2."""
+one line on stderr and exit code 2, a malformed command line included."""
 
 import argparse
 import os
@@ -289,8 +289,16 @@ _FAULT_HELP = ("a faulty actuator, MODULE:ACTUATOR:GAIN (module from 1, actuator
                "pneumatic arm; gain in [0, 1], 0 punctured); repeat for several")
 
 
+class _OneLineErrorParser(argparse.ArgumentParser):
+  """An argument parser (and, through ``add_subparsers``, its subcommands' parsers) whose
+  command-line errors are one line, pointing at ``--help`` instead of printing the usage."""
+
+  def error(self, message: str):
+    self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-  parser = argparse.ArgumentParser(prog="softbench", description=__doc__.split(".")[0] + ".")
+  parser = _OneLineErrorParser(prog="softbench", description=__doc__.split(".")[0] + ".")
   commands = parser.add_subparsers(dest="command", required=True)
   robots_parser = commands.add_parser("robots", help="list the benchmark robots or describe one")
   robots_parser.add_argument("name", nargs="?", help="e.g. tendon-3 or pneumatic-433")
@@ -301,7 +309,8 @@ def build_parser() -> argparse.ArgumentParser:
   collect_parser = commands.add_parser(
       "collect", help="record (or resume) a motor-babbling dataset",
       description="Motor babbling with every module active, cached under $SOFTBENCH_HOME "
-                  "(default ~/.cache/softbench); an interrupted collection resumes.")
+                  "(default $XDG_CACHE_HOME/softbench, or ~/.cache/softbench); an interrupted "
+                  "collection resumes.")
   collect_parser.add_argument("--robot", required=True, help="e.g. tendon-3 or pneumatic-433")
   collect_parser.add_argument("--samples", type=int, default=data.DEFAULT_SAMPLES,
                               help=f"control periods to record (default {data.DEFAULT_SAMPLES})")
@@ -344,7 +353,8 @@ def build_parser() -> argparse.ArgumentParser:
   run_parser = commands.add_parser(
       "run", help="train (or reuse) an agent and score it on a task over seeds",
       description="Collects or reuses the babbling dataset, trains or reuses the agent (cached "
-                  "by config), evaluates it closed loop and prints the errors over seeds.")
+                  "by config), evaluates it (closed loop in physics unless --eval says otherwise) "
+                  "and prints the errors over seeds.")
   run_parser.add_argument("--task", help=f"one of {', '.join(suite.TASKS)}")
   run_parser.add_argument("--protocol", help=f"{continual.PROTOCOL}: SMPL learns tendon-1 .. "
                                              f"tendon-5 in sequence; prints the paper's Exp1S "
@@ -389,7 +399,8 @@ def build_parser() -> argparse.ArgumentParser:
   render_parser = commands.add_parser(
       "render", help="render an agent's episode of a task to an MP4 video",
       description="Trains (or reuses) the agent for one seed, runs its episode and renders it "
-                  "off-screen (MUJOCO_GL=egl, else osmesa) with the target trail and the "
+                  "off-screen (the MUJOCO_GL you set, else egl, else osmesa) with the target "
+                  "trail and the "
                   "achieved tip path.")
   render_parser.add_argument("--task", required=True, help=f"one of {', '.join(suite.TASKS)}")
   render_parser.add_argument("--agent", required=True, help=f"one of {', '.join(agents.AGENTS)}")
@@ -432,7 +443,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-  args = build_parser().parse_args(argv)
+  try:
+    args = build_parser().parse_args(argv)
+  except SystemExit as done:  # --help (0), or a malformed command line (one line, 2).
+    return done.code
   run_module.one_line_warnings()
   try:
     with run_module.sigterm_as_interrupt():

@@ -184,6 +184,26 @@ def test_run_refuses_bad_input_with_one_line(argv, message, capsys, tmp_path):
   assert not list(pathlib.Path(tmp_path).glob("*.json"))
 
 
+@pytest.mark.parametrize("argv", [
+    ["run", "--task", "circle", "--agent", "zero", "--seeds", "x"],
+    ["run", "--task"],
+    ["frobnicate"],
+    [],
+    ["models"],
+])
+def test_a_malformed_command_line_is_one_line_and_exit_2(argv, capsys):
+  assert cli.main(argv) == cli.EXIT_USAGE
+  captured = capsys.readouterr()
+  lines = captured.err.strip().splitlines()
+  assert len(lines) == 1 and "error:" in lines[0] and "--help)" in lines[0]
+  assert not captured.out
+
+
+def test_help_still_prints_the_usage(capsys):
+  assert cli.main(["run", "--help"]) == 0
+  assert capsys.readouterr().out.startswith("usage: softbench run")
+
+
 def test_warnings_print_on_one_line(monkeypatch):
   monkeypatch.setattr(warnings, "formatwarning", warnings.formatwarning)  # Restored afterwards.
   run.one_line_warnings()

@@ -2,8 +2,9 @@
 
 ``load(robot, task, seed)`` returns a ``dm_control.rl.control.Environment``. Every task exists
 for every robot; ``ALL_TASKS`` lists the (robot, task) pairs of the benchmark robots and
-``BENCHMARKING`` those the leaderboard scores. ``custom`` follows a user's trajectory
-(``trajectory=ARRAY_OR_PATH``) and is in neither list, as it needs one.
+``BENCHMARKING`` those tagged ``benchmarking`` (dm_control's convention; so far every one).
+``custom`` follows a user's trajectory (``trajectory=ARRAY_OR_PATH``) and is in neither list, as
+it needs one.
 
 One control step lasts the robot's control period (``robot.control_timestep``): 1 s for the
 tendon arms (1 Hz, the paper's simulator; tendon-5, the slowest, settles in 0.72 s) and 0.2 s
