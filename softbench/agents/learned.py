@@ -302,10 +302,12 @@ def trained_forward_models(robot: robot_base.SoftArm, views: list[data.View], se
 def train_inverse(views: list[data.View], windows: list[data.SplitWindows],
                   forwards: list[smpl_forward.ForwardModel], seed: int, profile: profiles.Profile,
                   per_module: bool, make_model: ModelFactory | None, params: dict,
-                  progress_label: str | None = None, on_epoch: EpochCallback | None = None
-                  ) -> tuple[InverseModel, float]:
+                  progress_label: str | None = None, on_epoch: EpochCallback | None = None,
+                  restart_diverged: bool = True) -> tuple[InverseModel, float]:
   """Trains a fresh inverse model with hyperparameters ``params`` in closed loop through the
-  frozen forward models (one per view); returns it and its validation loss.
+  frozen forward models (one per view); returns it and its validation loss. A diverged training
+  starts again with half the learning rate (``restart_diverged``; ``smpl.training``), which a
+  tuning trial, scoring its own learning rate, turns off.
 
   The validation loss is the action MSE over the whole arm (normalised units, the aux term left
   out): a baseline's best validation loss, or for SMPL the columns' best losses weighted by their
@@ -333,11 +335,11 @@ def train_inverse(views: list[data.View], windows: list[data.SplitWindows],
             inverse, forwards[:index + 1],
             smpl_windows.ModuleWindows(tuple(split.train for split in windows[:index + 1])),
             smpl_windows.ModuleWindows(tuple(split.validation for split in windows[:index + 1])),
-            inverse_config, device, epoch_end)
+            inverse_config, device, epoch_end, restart_diverged=restart_diverged)
       else:
         result = training.train_inverse_model(inverse, forwards[index], windows[index].train,
                                               windows[index].validation, inverse_config, device,
-                                              epoch_end)
+                                              epoch_end, restart_diverged)
     best_losses.append(result.best_validation_loss)
   inverse.requires_grad_(False)
   return inverse, _action_weighted(best_losses, action_sizes)

@@ -200,8 +200,8 @@ class _Trainer:
                       on_epoch: learned.EpochCallback | None = None) -> float:
     _, loss = learned.train_inverse(self.views, self.windows, self.forwards, self.settings.seed,
                                     profile, self.learner.per_module, self.learner.make_model,
-                                    params, on_epoch=on_epoch)
-    return loss
+                                    params, on_epoch=on_epoch, restart_diverged=False)
+    return loss  # A diverging trial scores its own learning rate, not half of it.
 
 
 def summary(study: optuna.Study, settings: TuneSettings) -> dict:

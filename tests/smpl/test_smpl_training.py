@@ -328,3 +328,72 @@ def test_weight_decay_shrinks_the_weights(
         return sum(parameter.square().sum().item() for parameter in network.parameters())
 
     assert weight_norm(weight_decay=1.0) < weight_norm(weight_decay=0.0)
+
+
+def _zero_action_loss(windows: BabblingWindows) -> float:
+    return float(torch.mean(windows.actions**2))
+
+
+def test_a_training_that_does_not_diverge_is_untouched_by_restarts(
+    arm_data: dict[str, BabblingWindows], trained_forward_model: ForwardModel
+) -> None:
+    def train(restart_diverged: bool) -> tuple[dict[str, torch.Tensor], training.TrainingResult]:
+        network = _fresh_column()
+        result = train_inverse_model(network, trained_forward_model, arm_data["train"],
+                                     arm_data["validation"], SHORT_RUN, CPU,
+                                     restart_diverged=restart_diverged)
+        return _state(network), result
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        (plain, _), (guarded, result) = train(False), train(True)
+    assert result.best_validation_loss < _zero_action_loss(arm_data["validation"])
+    assert result.restarts == 0 and result.learning_rate is None
+    assert all(torch.equal(plain[name], guarded[name]) for name in plain)
+
+
+def test_a_diverged_training_starts_again_from_its_initial_weights_at_half_the_rate(
+    arm_data: dict[str, BabblingWindows], trained_forward_model: ForwardModel, monkeypatch
+) -> None:
+    network = _fresh_column()
+    initial = _state(network)
+    zero_action = _zero_action_loss(arm_data["validation"])
+    calls = []
+
+    def diverging_then_converging(model, batch_loss, train, validation, config, *args, **kwargs):
+        calls.append((config.learning_rate, _state(model)))
+        with torch.no_grad():  # What a diverged training leaves behind.
+            for parameter in model.parameters():
+                parameter.add_(1.0)
+        loss = 3 * zero_action if len(calls) < 3 else zero_action / 10
+        return training.TrainingResult(0, loss, True)
+
+    monkeypatch.setattr(training, "fit", diverging_then_converging)
+    with pytest.warns(UserWarning, match="training diverged") as caught:
+        result = train_inverse_model(network, trained_forward_model, arm_data["train"],
+                                     arm_data["validation"], SHORT_RUN, CPU,
+                                     restart_diverged=True)
+    rate = SHORT_RUN.learning_rate
+    assert [call[0] for call in calls] == [rate, rate / 2, rate / 4]
+    assert all(torch.equal(state[name], initial[name])
+               for _, state in calls for name in initial)  # Every attempt starts afresh.
+    assert len(caught) == 2 and "learning rate" in str(caught[0].message)
+    assert (result.restarts, result.learning_rate) == (2, rate / 4)
+    assert result.best_validation_loss == zero_action / 10
+
+
+def test_a_training_that_keeps_diverging_gives_up_with_a_warning(
+    arm_data: dict[str, BabblingWindows], trained_forward_model: ForwardModel
+) -> None:
+    config = dataclasses.replace(SHORT_RUN, max_epochs=1, learning_rate=1e4)
+    with pytest.warns(UserWarning) as caught:
+        result = train_inverse_model(MLPInverse(inverse_input_size(6, 2), 2),
+                                     trained_forward_model, arm_data["train"],
+                                     arm_data["validation"], config, CPU, restart_diverged=True)
+    messages = [str(warning.message) for warning in caught]
+    assert sum("training diverged" in message for message in messages) == \
+        training.DIVERGENCE_RESTARTS
+    assert any("still diverged" in message for message in messages)
+    assert result.restarts == training.DIVERGENCE_RESTARTS
+    assert result.learning_rate == 1e4 / 2**training.DIVERGENCE_RESTARTS
+    assert result.best_validation_loss >= _zero_action_loss(arm_data["validation"])
