@@ -514,12 +514,13 @@ def _fit_restarting(
         if zero_action_loss is None or result.best_validation_loss < zero_action_loss:
             break
         if restart == DIVERGENCE_RESTARTS:
-            warnings.warn(f"training still diverged after {restart} restarts (best validation "
-                          f"loss {result.best_validation_loss:.3g}, acting zero "
+            warnings.warn(f"training of seed {config.seed} still diverged after {restart} "
+                          f"restarts (best validation loss {result.best_validation_loss:.3g}, "
+                          f"acting zero "
                           f"{zero_action_loss:.3g}, learning rate {config.learning_rate:.3g})")
             break
-        warnings.warn(f"training diverged (best validation loss {result.best_validation_loss:.3g},"
-                      f" no lower than {zero_action_loss:.3g} for acting zero); training again "
+        warnings.warn(f"training of seed {config.seed} diverged (best validation loss "
+                      f"{result.best_validation_loss:.3g}, no lower than {zero_action_loss:.3g} for acting zero); training again "
                       f"from the initial weights with learning rate {config.learning_rate / 2:.3g}")
         model.load_state_dict(initial)
         config = dataclasses.replace(config, learning_rate=config.learning_rate / 2)

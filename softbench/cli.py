@@ -400,8 +400,7 @@ def build_parser() -> argparse.ArgumentParser:
       "render", help="render an agent's episode of a task to an MP4 video",
       description="Trains (or reuses) the agent for one seed, runs its episode and renders it "
                   "off-screen (the MUJOCO_GL you set, else egl, else osmesa) with the target "
-                  "trail and the "
-                  "achieved tip path.")
+                  "trail and the achieved tip path.")
   render_parser.add_argument("--task", required=True, help=f"one of {', '.join(suite.TASKS)}")
   render_parser.add_argument("--agent", required=True, help=f"one of {', '.join(agents.AGENTS)}")
   render_parser.add_argument("--robot", help="default: the task's robot in the paper")
