@@ -58,7 +58,8 @@ faster than 1, and with another process on the second core a 32x64 @ 64x256 matm
 DIVERGENCE_RESTARTS = 3
 """Restarts of a diverged inverse-model training, each with half the previous learning rate. The
 MLP's tuned rate (8.3e-3) diverged on 3 of 5 seeds of pneumatic-433's 14,000 samples (gradient
-norms up to 2.5e5 in the first epoch); half of it sufficed for 2 of them, a quarter is the next."""
+norms up to 2.5e5 in the first epoch). The rule sees only the weights kept: a training that
+diverges after a good enough epoch keeps that epoch."""
 _VALIDATION_CHUNK = 4096
 """Windows per gradient-free validation pass, to bound memory on large validation sets."""
 
