@@ -11,11 +11,12 @@ the forward model's predicted poses and the targets (off by default). The aux lo
 regulariser only: validation, and so early stopping and the best weights kept, leaves it out, which
 makes every inverse model's validation loss the same quantity.
 
-Divergence: given `restart_diverged`, an inverse-model training whose best validation loss is no
-lower than that of always acting zero (the middle of the normalised action range) has diverged;
-it starts again from its initial weights with half the learning rate, at most
-`DIVERGENCE_RESTARTS` times, with a warning each time. A training that did not diverge is
-untouched, to the bit.
+Divergence: given `restart_diverged`, an inverse-model training has diverged when its best
+validation loss is no lower than that of always acting zero (the middle of the normalised action
+range) and an epoch's training loss rose to `DIVERGED_LOSS_FACTOR` times that (a short training
+that has not learned yet is not diverged); it starts again from its initial weights with half
+the learning rate, at most `DIVERGENCE_RESTARTS` times, with a warning each time. A training that
+did not diverge is untouched, to the bit.
 """
 
 from __future__ import annotations
@@ -60,6 +61,10 @@ DIVERGENCE_RESTARTS = 3
 MLP's tuned rate (8.3e-3) diverged on 3 of 5 seeds of pneumatic-433's 14,000 samples (gradient
 norms up to 2.5e5 in the first epoch). The rule sees only the weights kept: a training that
 diverges after a good enough epoch keeps that epoch."""
+DIVERGED_LOSS_FACTOR = 10.0
+"""How far above acting zero's loss an epoch's training loss must rise for a training that ends no
+better than acting zero to count as diverged. The MLP's diverged trainings reached 35 to 175
+times; undertrained ones (2 epochs of the tests' tiny profile) stay near 1."""
 _VALIDATION_CHUNK = 4096
 """Windows per gradient-free validation pass, to bound memory on large validation sets."""
 
@@ -495,6 +500,13 @@ def _zero_action_loss(actions: Sequence[Tensor]) -> float:
     return sum(float(torch.mean(module ** 2)) for module in actions) / len(actions)
 
 
+def _diverged(result: TrainingResult, zero_action_loss: float) -> bool:
+    """Whether a training diverged (module docstring)."""
+    return (result.best_validation_loss >= zero_action_loss and
+            max(report.train_loss for report in result.history)
+            >= DIVERGED_LOSS_FACTOR * zero_action_loss)
+
+
 def _fit_restarting(
     model: nn.Module,
     batch_loss: BatchLoss,
@@ -512,7 +524,7 @@ def _fit_restarting(
     for restart in range(DIVERGENCE_RESTARTS + 1):
         result = fit(model, batch_loss, train, validation, config, device, on_epoch_end,
                      validation_loss)
-        if zero_action_loss is None or result.best_validation_loss < zero_action_loss:
+        if zero_action_loss is None or not _diverged(result, zero_action_loss):
             break
         if restart == DIVERGENCE_RESTARTS:
             warnings.warn(f"training of seed {config.seed} still diverged after {restart} "

@@ -366,7 +366,9 @@ def test_a_diverged_training_starts_again_from_its_initial_weights_at_half_the_r
             for parameter in model.parameters():
                 parameter.add_(1.0)
         loss = 3 * zero_action if len(calls) < 3 else zero_action / 10
-        return training.TrainingResult(0, loss, True)
+        blown_up = 100 * zero_action if len(calls) < 3 else loss
+        return training.TrainingResult(0, loss, True, [training.EpochReport(0, blown_up, loss,
+                                                                            loss, True, 0.1)])
 
     monkeypatch.setattr(training, "fit", diverging_then_converging)
     with pytest.warns(UserWarning, match="training of seed 0 diverged") as caught:
@@ -397,3 +399,23 @@ def test_a_training_that_keeps_diverging_gives_up_with_a_warning(
     assert result.restarts == training.DIVERGENCE_RESTARTS
     assert result.learning_rate == 1e4 / 2**training.DIVERGENCE_RESTARTS
     assert result.best_validation_loss >= _zero_action_loss(arm_data["validation"])
+
+
+def test_a_short_training_that_has_not_learned_yet_is_not_diverged(
+    arm_data: dict[str, BabblingWindows], trained_forward_model: ForwardModel, monkeypatch
+) -> None:
+    zero_action = _zero_action_loss(arm_data["validation"])
+    calls = []
+
+    def barely_trained(model, batch_loss, train, validation, config, *args, **kwargs):
+        calls.append(config.learning_rate)
+        return training.TrainingResult(0, 1.1 * zero_action, False, [training.EpochReport(
+            0, 1.5 * zero_action, 1.1 * zero_action, 1.1 * zero_action, True, 0.1)])
+
+    monkeypatch.setattr(training, "fit", barely_trained)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        result = train_inverse_model(_fresh_column(), trained_forward_model, arm_data["train"],
+                                     arm_data["validation"], SHORT_RUN, CPU,
+                                     restart_diverged=True)
+    assert calls == [SHORT_RUN.learning_rate] and result.restarts == 0
