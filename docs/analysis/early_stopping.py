@@ -38,8 +38,9 @@ def main() -> None:
   args = parser.parse_args()
 
   arm, profile = robots.make(args.robot), profiles.get(args.profile)
-  entry = agents.describe(args.agent)
-  learner = importlib.import_module(entry.module).LEARNER if entry.learned else None
+  agent_entry = agents.describe(args.agent)
+  learner = (importlib.import_module(agent_entry.module).LEARNER if agent_entry.learned
+             else None)
   if learner is None or learner.per_module:
     raise SystemExit(f"{args.agent} trains column by column; pick a centralised agent")
   (view,) = views = learner.views(arm)
@@ -50,11 +51,10 @@ def main() -> None:
   with training.seeded(args.seed, torch.device("cpu")):
     inverse = learned._inverse_model(views, False, learner.make_model, params)
 
-  kept, losses = {}, {}
+  kept = {}
 
   def keep(report: training.EpochReport) -> None:
     epoch = report.epoch + 1  # Epochs trained so far.
-    losses[epoch] = (report.train_loss, report.validation_loss)
     print(f"epoch {epoch}: training loss {report.train_loss:.4f}, "
           f"validation {report.validation_loss:.4f}", flush=True)
     if epoch in args.keep:
@@ -62,7 +62,7 @@ def main() -> None:
 
   result = training.train_inverse_model(inverse, forwards[0], windows[0].train,
                                         windows[0].validation, config,
-                                        training.default_device(), keep)
+                                        training.default_device(), keep, restart_diverged=True)
   best = f"best validation (epoch {result.best_epoch + 1}, what early stopping keeps)"
   kept = {best: copy.deepcopy(inverse.state_dict()), **kept}
   settings = run.settings(args.task, args.agent, args.robot, seeds=1, profile=args.profile)
