@@ -41,7 +41,10 @@ def test_a_dead_worker_is_reported_not_waited_for():
 
 
 _INTERRUPTED_PROGRAM = """
-import sys, time
+import signal, sys, time
+# Ctrl-C as in a terminal, even where the test runner was started as a background job of a
+# non-interactive shell, which leaves SIGINT ignored in every process it starts.
+signal.signal(signal.SIGINT, signal.default_int_handler)
 sys.path.insert(0, {tests!r})
 from softbench import run
 import test_parallel_seeds
