@@ -518,8 +518,8 @@ def _fit_restarting(
     validation_loss: BatchLoss | None,
     zero_action_loss: float | None,
 ) -> TrainingResult:
-    """`fit`; when `zero_action_loss` is given, a fit whose best validation loss is no lower
-    starts again from the initial weights with half the learning rate (module docstring)."""
+    """`fit`; when `zero_action_loss` is given, a diverged fit (`_diverged`) starts again from
+    the initial weights with half the learning rate (module docstring)."""
     initial = _copy_state(model) if zero_action_loss is not None else None
     for restart in range(DIVERGENCE_RESTARTS + 1):
         result = fit(model, batch_loss, train, validation, config, device, on_epoch_end,
@@ -529,12 +529,13 @@ def _fit_restarting(
         if restart == DIVERGENCE_RESTARTS:
             warnings.warn(f"training of seed {config.seed} still diverged after {restart} "
                           f"restarts (best validation loss {result.best_validation_loss:.3g}, "
-                          f"acting zero "
-                          f"{zero_action_loss:.3g}, learning rate {config.learning_rate:.3g})")
+                          f"acting zero {zero_action_loss:.3g}, learning rate "
+                          f"{config.learning_rate:.3g})")
             break
         warnings.warn(f"training of seed {config.seed} diverged (best validation loss "
-                      f"{result.best_validation_loss:.3g}, no lower than {zero_action_loss:.3g} for acting zero); training again "
-                      f"from the initial weights with learning rate {config.learning_rate / 2:.3g}")
+                      f"{result.best_validation_loss:.3g}, no lower than {zero_action_loss:.3g} "
+                      f"for acting zero); training again from the initial weights with "
+                      f"learning rate {config.learning_rate / 2:.3g}")
         model.load_state_dict(initial)
         config = dataclasses.replace(config, learning_rate=config.learning_rate / 2)
     if restart:

@@ -57,7 +57,8 @@ def probe(dataset: data.Dataset, modules: int, actions: slice, seed: int) -> dic
   validation_inputs, validation_actions = split_arrays(dataset, "validation", modules, actions)
   mean, std = train_inputs.mean(0), train_inputs.std(0) + 1e-9
   tensor = lambda array: torch.as_tensor(array, dtype=torch.float32)
-  x_train, x_validation = tensor((train_inputs - mean) / std), tensor((validation_inputs - mean) / std)
+  x_train = tensor((train_inputs - mean) / std)
+  x_validation = tensor((validation_inputs - mean) / std)
   a_train, a_validation = tensor(train_actions), tensor(validation_actions)
   network = torch.nn.Sequential(
       torch.nn.Linear(x_train.shape[1], PROBE_UNITS), torch.nn.Tanh(),
