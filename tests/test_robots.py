@@ -358,18 +358,43 @@ def _module_series_compliance(model: mujoco.MjModel, module: int, kind: str) -> 
   return float(sum(1.0 / k for k in stiffness if k > 0))
 
 
-@pytest.mark.parametrize("robot_name", _robots())
+def _rod_segments(model: mujoco.MjModel, module: int) -> list[int]:
+  """Body ids of a module's rod segments."""
+  return [b for b in range(model.nbody) if model.body(b).name.startswith(f"module{module}_segment")]
+
+
+# Every backbone the robots build: the cable plugin (tendon arms' default), ball-joint springs
+# (``backbone="joints"``) and the pneumatic arm's ball and slide springs.
+_BACKBONES = ([pytest.param(name, {}, id=name) for name in BENCHMARK_ROBOTS]
+              + [pytest.param(name, {"backbone": "joints"}, id=f"{name}-joints")
+                 for name in BENCHMARK_ROBOTS if name.startswith("tendon-")])
+
+
+@pytest.mark.parametrize("robot_name, overrides", _BACKBONES)
 @pytest.mark.parametrize("factor", [2, 3])
-def test_refining_keeps_every_module_material(robot_name, factor):
+def test_refining_keeps_every_module_material(robot_name, overrides, factor):
   # Springs per joint that do not scale with the segment count soften a module as it is refined;
   # the pneumatic arm's slide joints did, and its discretisation error was 7.1 % of the length
-  # instead of 0.43 %.
-  robot = make(robot_name)
+  # instead of 0.43 %. The cable plugin derives each element's stiffness from E, G, the rod's
+  # radius and the element's length, so there every segment must keep the plugin and the radius.
+  robot = make(robot_name, **overrides)
   coarse, fine = robot.compile(), robot.refined(factor).compile()
   # Segments straddle module boundaries (the rod is staggered), so mass is compared as a whole;
   # the exported XML keeps 6 significant digits.
   assert robot.mass(fine) == pytest.approx(robot.mass(coarse), rel=1e-5)
+  assert fine.nplugin == coarse.nplugin
+  assert bytes(fine.plugin_attr) == bytes(coarse.plugin_attr)  # The plugin's E and G.
   for module in range(1, robot.num_modules + 1):
+    radii = []
+    for model in (coarse, fine):
+      segments = _rod_segments(model, module)
+      assert len(segments) == robot.segments_per_module * (1 if model is coarse else factor)
+      assert {int(model.body_plugin[b]) >= 0 for b in segments} == {coarse.nplugin > 0}, module
+      radii.append({float(model.geom_size[g][0]) for g in range(model.ngeom)
+                    if model.geom_bodyid[g] in segments})
+    assert len(radii[0]) == 1 and radii[1] == radii[0], (module, radii)
+    if coarse.nplugin == 0:  # Springs carry the elasticity: every module has bending springs.
+      assert _module_series_compliance(coarse, module, "ball") > 0, module
     for kind in ("slide", "ball"):
       assert _module_series_compliance(fine, module, kind) == pytest.approx(
           _module_series_compliance(coarse, module, kind), rel=1e-5), (module, kind)
