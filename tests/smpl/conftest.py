@@ -2,12 +2,17 @@
 
 from __future__ import annotations
 
+import importlib
+import inspect
+import pkgutil
 from collections.abc import Callable, Iterator
 
 import pytest
 import torch
 
+import smpl
 from smpl.forward_model import ForwardModel
+from smpl.inverse import InverseModel
 from smpl.training import (
     CPU_THREADS,
     ForwardTrainingConfig,
@@ -74,3 +79,19 @@ def trained_forward_model(arm_data: dict[str, BabblingWindows]) -> ForwardModel:
         device=torch.device("cpu"),
     )
     return forward_model
+
+
+@pytest.fixture(scope="session")
+def inverse_model_classes() -> set[type]:
+    """Every concrete `InverseModel` class of the smpl package (all its modules imported), so
+    that a test over "every inverse model" can check that it lists them all."""
+    for module in pkgutil.iter_modules(smpl.__path__):
+        importlib.import_module(f"smpl.{module.name}")
+
+    def subclasses(cls: type) -> Iterator[type]:
+        for subclass in cls.__subclasses__():
+            yield subclass
+            yield from subclasses(subclass)
+
+    return {cls for cls in subclasses(InverseModel)
+            if not inspect.isabstract(cls) and cls.__module__.startswith("smpl.")}

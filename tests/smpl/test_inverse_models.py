@@ -30,6 +30,10 @@ INVERSE_MODELS: dict[str, Callable[[], InverseModel]] = {
 }
 
 
+def test_every_inverse_model_is_listed(inverse_model_classes: set[type]) -> None:
+    assert {type(make()) for make in INVERSE_MODELS.values()} == inverse_model_classes
+
+
 @pytest.fixture(params=sorted(INVERSE_MODELS))
 def model(request: pytest.FixtureRequest) -> InverseModel:
     torch.manual_seed(0)

@@ -10,7 +10,7 @@ from rich.console import Console
 from smpl.baselines import BiLSTMInverse, LSTMInverse, MLPInverse, VAELSTMInverse
 from smpl.forward_model import ForwardModel
 from smpl.progress import EpochProgressBar
-from smpl.progressive import ProgressiveLSTM
+from smpl.progressive import ProgressiveColumn, ProgressiveLSTM
 from smpl.training import (
     EarlyStopping,
     ForwardTrainingConfig,
@@ -269,28 +269,51 @@ INVERSE_MODELS = {
 }
 
 
+def test_every_trainable_inverse_model_is_listed(inverse_model_classes: set[type]) -> None:
+    # A ProgressiveColumn is a view of one column for acting; its network is what trains.
+    listed = {type(make()) for make in INVERSE_MODELS.values()}
+    assert listed == inverse_model_classes - {ProgressiveColumn}
+
+
+@pytest.fixture
+def compiled_functions(monkeypatch) -> list:
+    """What `smpl.training` hands to torch.compile during the test (still compiled)."""
+    handed, compiled = [], training._compiled
+
+    def counting(function):
+        handed.append(function)
+        return compiled(function)
+
+    monkeypatch.setattr(training, "_compiled", counting)
+    return handed
+
+
 @pytest.mark.parametrize("name", INVERSE_MODELS)
 def test_every_model_compiles_or_says_it_cannot(
-    name: str, arm_data: dict[str, BabblingWindows], trained_forward_model: ForwardModel
+    name: str, arm_data: dict[str, BabblingWindows], trained_forward_model: ForwardModel,
+    compiled_functions: list
 ) -> None:
-    """With compile asked, a model compiles on the CPU if its `compiles_on_cpu` says it can, and
-    trains eagerly otherwise: never a failed compile, which warns before falling back."""
+    """With compile asked, a model compiles on the CPU (its loss and optimiser step) if its
+    `compiles_on_cpu` says it can, and trains eagerly otherwise: never a failed compile, which
+    warns before falling back."""
     model = INVERSE_MODELS[name]()
     config = dataclasses.replace(SHORT_RUN, max_epochs=1, compile=True)
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)  # "torch.compile failed" would raise.
         train_inverse_model(model, trained_forward_model, arm_data["train"],
                             arm_data["validation"], config, CPU)
+    assert len(compiled_functions) == (2 if getattr(model, "compiles_on_cpu", True) else 0)
 
 
 def test_the_forward_model_trains_eagerly_on_the_cpu_without_a_warning(
-    arm_data: dict[str, BabblingWindows]
+    arm_data: dict[str, BabblingWindows], compiled_functions: list
 ) -> None:
     config = dataclasses.replace(ForwardTrainingConfig(), max_epochs=1, compile=True)
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)
         train_forward_model(ForwardModel(actuation_size=2, hidden_size=8), arm_data["train"],
                             arm_data["validation"], config, CPU)
+    assert compiled_functions == []
 
 
 def test_validation_leaves_out_the_aux_loss(
