@@ -109,7 +109,8 @@ def reach_actions(agent, active=None, helpers="hold", seed=0):
     agent.active_modules, agent.helper_targets = None, "hold"
 
 
-@pytest.mark.parametrize("agent_name", ["smpl", "lstm"])
+@pytest.mark.parametrize("agent_name", [name for name in agents.AGENTS
+                                        if agents.describe(name).learned])
 class TestMasking:
 
   def test_inactive_modules_get_exactly_zero(self, agent_name):
