@@ -25,17 +25,25 @@ models: $(STAMP)
 	$(VENV)/bin/softbench models export --measure-speed
 
 # Every agent on every task of the leaderboard's robots, then the Exp1S protocol, then the pages.
-# PROFILE=paper (default) is the paper's budget: hours per agent on a laptop CPU. Every run reuses
-# cached datasets, checkpoints and training snapshots, so an interrupted fill resumes; the pages
-# show the newest record of each setting.
+# PROFILE=paper (default) is the paper's budget: hours per agent on a laptop CPU. A setting that
+# already has a record of this profile in leaderboard/results is skipped, and a run under way
+# resumes from the cached datasets, checkpoints, training snapshots and finished seeds, so an
+# interrupted fill goes on where it stopped; the pages show the newest record of each setting.
 PROFILE ?= paper
+RESULTS := leaderboard/results
 LEADERBOARD_ROBOTS := tendon-3 pneumatic-433
 LEADERBOARD_TASKS := babbling circle rectangle spiral reach
 LEADERBOARD_AGENTS := smpl mlp lstm vae-lstm bilstm reference zero random
 leaderboard: $(STAMP)
 	set -e; for robot in $(LEADERBOARD_ROBOTS); do for task in $(LEADERBOARD_TASKS); do \
 	  for agent in $(LEADERBOARD_AGENTS); do \
-	    $(VENV)/bin/softbench run --robot $$robot --task $$task --agent $$agent --profile $(PROFILE); \
+	    if ls $(RESULTS)/$$agent-$$robot-$$task-$(PROFILE)-physics-*.json >/dev/null 2>&1; then \
+	      echo "skipped $$agent on $$robot $$task: it has a $(PROFILE) record"; continue; fi; \
+	    $(VENV)/bin/softbench run --robot $$robot --task $$task --agent $$agent --profile $(PROFILE) \
+	      --results $(RESULTS); \
 	  done; done; done
-	$(VENV)/bin/softbench run --protocol exp1s --agent smpl --profile $(PROFILE)
-	$(VENV)/bin/softbench leaderboard --write
+	if ls $(RESULTS)/smpl-exp1s-$(PROFILE)-*.json >/dev/null 2>&1; then \
+	  echo "skipped exp1s: it has a $(PROFILE) record"; \
+	else $(VENV)/bin/softbench run --protocol exp1s --agent smpl --profile $(PROFILE) \
+	  --results $(RESULTS); fi
+	$(VENV)/bin/softbench leaderboard --results $(RESULTS) --write
