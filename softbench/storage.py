@@ -31,16 +31,21 @@ def write_atomically(path: pathlib.Path, content: str | bytes) -> None:
   """Writes ``content`` (text or bytes) to ``path`` through a temporary file and a rename.
 
   The file gets the permissions a plain ``open`` would give (0666 less the umask), not the
-  owner-only mode of the temporary file."""
+  owner-only mode of the temporary file. A failed write (a full disk, ``path`` a folder) removes
+  the temporary file and raises its error."""
   path = pathlib.Path(path)
   path.parent.mkdir(parents=True, exist_ok=True)
-  mode = "wb" if isinstance(content, bytes) else "w"
-  with tempfile.NamedTemporaryFile(mode, dir=path.parent, delete=False, suffix=".tmp") as f:
-    f.write(content)
-    f.flush()
-    os.fsync(f.fileno())
-  os.chmod(f.name, _FILE_MODE & ~_umask())
-  os.replace(f.name, path)
+  handle, temporary = tempfile.mkstemp(suffix=".tmp", dir=path.parent)
+  try:
+    with os.fdopen(handle, "wb" if isinstance(content, bytes) else "w") as file:
+      file.write(content)
+      file.flush()
+      os.fsync(file.fileno())
+    os.chmod(temporary, _FILE_MODE & ~_umask())
+    os.replace(temporary, path)
+  except BaseException:
+    pathlib.Path(temporary).unlink(missing_ok=True)
+    raise
 
 
 def _umask() -> int:

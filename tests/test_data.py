@@ -439,3 +439,21 @@ def test_atomic_writes_get_the_permissions_of_a_plain_open(tmp_path):
   storage.write_atomically(atomic, "x")
   assert atomic.stat().st_mode == plain.stat().st_mode
   assert not list(tmp_path.glob("*.tmp"))
+
+
+def _full_disk(descriptor):
+  raise OSError(28, "No space left on device")
+
+
+@pytest.mark.parametrize("failure", ["target is a folder", "full disk"])
+def test_a_failed_atomic_write_leaves_no_temporary_file(failure, tmp_path, monkeypatch):
+  target = tmp_path / "file.txt"
+  if failure == "target is a folder":
+    target.mkdir()
+  else:
+    target.write_text("old")
+    monkeypatch.setattr(storage.os, "fsync", _full_disk)
+  with pytest.raises(OSError):
+    storage.write_atomically(target, "new")
+  assert sorted(path.name for path in tmp_path.iterdir()) == ["file.txt"]
+  assert failure == "target is a folder" or target.read_text() == "old"

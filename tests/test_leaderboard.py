@@ -7,6 +7,7 @@ others are variants of it (another agent, date or scale of the errors), sealed a
 import copy
 import json
 import math
+import os
 import pathlib
 import warnings
 
@@ -114,6 +115,13 @@ MALFORMED = {
     "extra scalar field": (_set(["score"], 3), True, "score: unknown field"),
     "old version": (_set(["version"], 1), True, "record version 1 is not read"),
     "other format": (_set(["format"], "csv"), True, "not a result record"),
+    "format not a string": (_set(["format"], []), True, r"not a result record \(format \[\]"),
+    "astronomical error": (_set(["per_seed", 0, "position_mm", "per_module"], [1e308]), True,
+                           r"per_module\[0\]: 1e\+308 is greater than the maximum of 1000000"),
+    "integer beyond floats": (_set(["per_seed", 0, "position_mm", "per_module"], [10**400]),
+                              True, "is greater than the maximum of 1000000"),
+    "astronomical wall time": (_set(["wall_time_s"], 1e300), True,
+                               r"wall_time_s: 1e\+300 is greater than the maximum"),
     "seed count": (_set(["seeds"], 3), True, "seeds is 3 but per_seed has 2 entries"),
     "repeated seed": (_set(["per_seed", 1, "seed"], 0), True, "repeats a seed"),
     "module count": (_set(["per_seed", 0, "position_mm", "per_module"], [1.0, 1.0]), True,
@@ -150,6 +158,52 @@ def test_the_cli_refuses_a_folder_with_a_bad_record(real_record, tmp_path, capsy
   (tmp_path / "broken.json").unlink()
   assert cli.main(["leaderboard", "--results", str(tmp_path)]) == cli.EXIT_USAGE
   assert "edited.json: content does not match its sha256" in capsys.readouterr().err
+
+
+UNPARSABLE = {
+    "nested too deeply": ("[" * 100_000 + "]" * 100_000, "nested too deeply"),
+    "too many digits": ('{"format": ' + "1" * 5000 + "}", "integer string conversion"),
+}
+
+
+@pytest.mark.parametrize("case", UNPARSABLE)
+def test_an_unparsable_record_is_refused_with_one_line_naming_it(case, tmp_path, capsys):
+  text, message = UNPARSABLE[case]
+  path = tmp_path / "bad.json"
+  path.write_text(text)
+  with pytest.raises(records.RecordError, match=message) as raised:
+    records.read(path)
+  assert str(raised.value).startswith(f"{path}: ") and "\n" not in str(raised.value)
+  assert cli.main(["leaderboard", "--results", str(tmp_path)]) == cli.EXIT_USAGE
+  assert capsys.readouterr().err == f"softbench: error: {raised.value}\n"
+
+
+def test_a_broken_link_is_refused_as_one(real_record, tmp_path, capsys):
+  run.write_record(real_record, tmp_path / "good.json")
+  (tmp_path / "gone.json").symlink_to(tmp_path / "nowhere.json")
+  assert cli.main(["leaderboard", "--results", str(tmp_path)]) == cli.EXIT_USAGE
+  (line,) = capsys.readouterr().err.splitlines()
+  assert line.startswith(f"softbench: error: {tmp_path / 'gone.json'}: a broken link")
+  with pytest.raises(FileNotFoundError):  # A plain missing file is no record error.
+    records.read(tmp_path / "missing.json")
+
+
+def test_an_unreadable_results_folder_is_an_error_not_an_empty_one(real_record, tmp_path,
+                                                                     monkeypatch, capsys):
+  run.write_record(real_record, tmp_path / "good.json")
+  scandir = os.scandir
+
+  def forbidden(path=".", *args):
+    if pathlib.Path(path) == tmp_path:
+      raise PermissionError(13, "Permission denied", str(path))
+    return scandir(path, *args)
+
+  monkeypatch.setattr(os, "scandir", forbidden)
+  assert cli.main(["leaderboard", "--results", str(tmp_path)]) == cli.EXIT_USAGE
+  captured = capsys.readouterr()
+  assert captured.err == (f"softbench: error: {tmp_path}: the folder of result records cannot "
+                          f"be read (Permission denied)\n")
+  assert "no result records" not in captured.out
 
 
 def test_run_refuses_to_write_a_malformed_record(real_record, tmp_path):

@@ -5,13 +5,17 @@ the properties do not depend on the length.
 """
 
 import json
+import re
+import warnings
 
 import numpy as np
 import pytest
 from dm_env import specs
 
 from softbench import robots
+from softbench import run
 from softbench import suite
+from softbench.data import dataset
 from softbench.robots import recorder
 from softbench.suite import references
 
@@ -144,7 +148,7 @@ def test_reference_shapes_differ_and_stay_in_unit_actuation():
   assert magnitude[:10].mean() < magnitude[-10:].mean()
 
 
-def test_reference_is_cached_and_a_corrupt_cache_is_regenerated(monkeypatch, tmp_path, caplog):
+def test_reference_is_cached_and_a_corrupt_cache_is_regenerated(monkeypatch, tmp_path):
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
   arm = robots.make("tendon-1")
   first = references.reference(arm, "circle", length=5)
@@ -161,11 +165,47 @@ def test_reference_is_cached_and_a_corrupt_cache_is_regenerated(monkeypatch, tmp
   data = bytearray(npz.read_bytes())
   data[len(data) // 2] ^= 0xFF
   npz.write_bytes(bytes(data))
-  regenerated = references.reference(arm, "circle", length=5)
-  assert "unreadable" in caplog.text
+  with pytest.warns(dataset.CorruptFileWarning, match=re.escape(f"{npz}: unreadable cached reference")):
+    regenerated = references.reference(arm, "circle", length=5)
   np.testing.assert_array_equal(regenerated.poses, first.poses)
   meta = json.loads(npz.with_suffix(".json").read_text())
   assert meta["config"]["shape"] == "circle"
+
+
+@pytest.mark.parametrize("description", ["[]", "null", '"text"', '{"config": 1}', "{", "",
+                                         "[" * 100_000])
+def test_a_malformed_cached_reference_description_is_regenerated(description, monkeypatch,
+                                                                  tmp_path):
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
+  arm = robots.make("tendon-1")
+  first = references.reference(arm, "circle", length=4)
+  (meta,) = (tmp_path / "references").glob("*.json")
+  meta.write_text(description)
+  with pytest.warns(dataset.CorruptFileWarning, match="unreadable cached reference"):
+    regenerated = references.reference(arm, "circle", length=4)
+  np.testing.assert_array_equal(regenerated.poses, first.poses)
+  assert json.loads(meta.read_text())["config"]["shape"] == "circle"
+  with warnings.catch_warnings():
+    warnings.simplefilter("error")
+    references.reference(arm, "circle", length=4)  # Cached again, intact.
+
+
+def test_a_damaged_reference_warns_on_one_softbench_line(monkeypatch, tmp_path):
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
+  arm = robots.make("tendon-1")
+  references.reference(arm, "circle", length=4)
+  (meta,) = (tmp_path / "references").glob("*.json")
+  meta.write_text("null")
+  with pytest.warns(dataset.CorruptFileWarning) as caught:
+    references.reference(arm, "circle", length=4)
+  monkeypatch.setattr(warnings, "formatwarning", warnings.formatwarning)
+  run.one_line_warnings()  # As the command line prints warnings.
+  (warning,) = caught
+  printed = warnings.formatwarning(warning.message, warning.category, warning.filename,
+                                   warning.lineno)
+  assert printed.startswith(f"softbench: warning: {meta.with_suffix('.npz')}: unreadable "
+                            f"cached reference (")
+  assert printed.count("\n") == 1 and printed.endswith("; generating it again\n")
 
 
 def test_reach_targets_are_reachable_points_that_vary_with_seed():

@@ -14,13 +14,19 @@ from softbench import profiles
 INTEGRITY_FIELD = "sha256"
 AGENT_PATTERN = r"^[a-z0-9][a-z0-9_.-]*$"
 ROBOT_PATTERN = r"^(tendon-[0-9]+|pneumatic-433)$"
+MAX_ERROR = 1e6
+"""Bound on every error in a record (mm, deg, %, pose MSE). The arms are at most 0.5 m long, so
+real errors stay below a few thousand; the bound refuses absurd values (1e308 would overflow the
+sums of the consistency checks and the means of the pages)."""
+MAX_WALL_TIME_S = 1e9  # (s) About 32 years: bounds the wall time likewise.
 
 Refuse = Callable[[str], NoReturn]
 """Raises the record's error with a one-line message (the caller adds the file's name)."""
 
 
-def non_negative() -> dict:
-  return {"type": "number", "minimum": 0}
+def non_negative(maximum: float = MAX_ERROR) -> dict:
+  """A number from 0 to ``maximum``."""
+  return {"type": "number", "minimum": 0, "maximum": maximum}
 
 
 def section() -> dict:
@@ -38,7 +44,7 @@ def properties() -> dict:
       "profile_settings": {"type": "object", "required": ["name"],
                            "properties": {"name": {"type": "string"}}},
       "seeds": {"type": "integer", "minimum": 1},
-      "wall_time_s": non_negative(),
+      "wall_time_s": non_negative(MAX_WALL_TIME_S),
       "date": {"type": "string", "format": "date-time"},
       "machine": {"type": "object"},
       INTEGRITY_FIELD: {"type": "string", "pattern": "^[0-9a-f]{64}$"},

@@ -20,6 +20,7 @@ import dataclasses
 import hashlib
 import json
 import math
+import os
 import pathlib
 from collections.abc import Callable
 
@@ -158,13 +159,18 @@ def read(path: pathlib.Path) -> dict:
   """The checked record in ``path``.
 
   Raises:
-    RecordError: the file is not valid JSON or not a valid, untouched record (one line).
+    RecordError: the file is not valid JSON or not a valid, untouched record, or is a broken
+      link (one line).
     FileNotFoundError: no such file.
   """
   path = pathlib.Path(path)
   try:
     record = json.loads(path.read_text(encoding="utf-8"))
+    validate(record, str(path))
   except FileNotFoundError:
+    if path.is_symlink():
+      raise RecordError(f"{path}: a broken link (to {os.readlink(path)}, which does not "
+                        f"exist)") from None
     raise
   except OSError as error:
     raise RecordError(f"{path}: cannot be read ({error.strerror})") from None
@@ -173,7 +179,13 @@ def read(path: pathlib.Path) -> dict:
   except json.JSONDecodeError as error:
     raise RecordError(f"{path}: not valid JSON ({error.msg} at line {error.lineno}, "
                       f"column {error.colno})") from None
-  validate(record, str(path))
+  except RecursionError:
+    raise RecordError(f"{path}: not a result record (nested too deeply)") from None
+  except RecordError:
+    raise
+  except ValueError as error:  # An integer beyond Python's digit limit, ...
+    message = _shortened(str(error).split(";")[0])
+    raise RecordError(f"{path}: not a usable record ({message})") from None
   return record
 
 
@@ -182,12 +194,21 @@ def read_folder(folder: pathlib.Path) -> list[tuple[pathlib.Path, dict]]:
   does not exist.
 
   Raises:
-    RecordError: a file is not a valid, untouched record, or ``folder`` is a file (one line).
+    RecordError: a file is not a valid, untouched record, or ``folder`` is a file or cannot be
+      read (one line).
   """
   folder = pathlib.Path(folder)
-  if folder.exists() and not folder.is_dir():
-    raise RecordError(f"{folder}: not a folder of result records")
-  return [(path, read(path)) for path in sorted(folder.glob("*.json"))]
+  try:  # Not pathlib's glob, which takes an unreadable folder for an empty one.
+    with os.scandir(folder) as entries:
+      names = sorted(entry.name for entry in entries if entry.name.endswith(".json"))
+  except FileNotFoundError:
+    return []
+  except NotADirectoryError:
+    raise RecordError(f"{folder}: not a folder of result records") from None
+  except OSError as error:
+    raise RecordError(f"{folder}: the folder of result records cannot be read "
+                      f"({error.strerror})") from None
+  return [(folder / name, read(folder / name)) for name in names]
 
 
 def validate(record: object, source: str) -> None:
@@ -199,16 +220,17 @@ def validate(record: object, source: str) -> None:
   if not isinstance(record, dict):
     raise RecordError(f"{source}: not a result record (a JSON object is expected)")
   known = kinds()
-  kind = known.get(record.get("format"))
+  found = record.get("format")
+  kind = known.get(found) if isinstance(found, str) else None
   if kind is None:
-    raise RecordError(f"{source}: not a result record (format {record.get('format')!r}, "
+    raise RecordError(f"{source}: not a result record (format {_shortened(repr(found))}, "
                       f"expected one of {', '.join(map(repr, known))})")
   version = record.get("version")
   if version != kind.version:
     why = ("it has no integrity hash, so it cannot be checked; run it again"
            if isinstance(version, int) and version < kind.version else
            f"this softbench reads version {kind.version}")
-    raise RecordError(f"{source}: record version {version!r} is not read: {why}")
+    raise RecordError(f"{source}: record version {_shortened(repr(version))} is not read: {why}")
   _check_finite(record, source)
   error = schema_exceptions.best_match(
       jsonschema.Draft202012Validator(kind.schema()).iter_errors(record))
@@ -231,14 +253,24 @@ def _where(path) -> str:
   return where or "record"
 
 
+def _shortened(message: str) -> str:
+  """``message`` in at most ``_MAX_MESSAGE_CHARS`` characters: its middle (a long value) cut,
+  so that the reason at its end stays."""
+  if len(message) <= _MAX_MESSAGE_CHARS:
+    return message
+  half = (_MAX_MESSAGE_CHARS - 3) // 2
+  return message[:half] + "..." + message[-half:]
+
+
 def _describe(error: schema_exceptions.ValidationError) -> str:
-  if "additionalProperties" in error.schema_path:
-    return (f"{_where(error.absolute_path)}: unknown field (extra fields must be sections, "
-            f"JSON objects): {error.message}"[:_MAX_MESSAGE_CHARS])
-  message = error.message
-  if len(message) > _MAX_MESSAGE_CHARS:
-    message = message[:_MAX_MESSAGE_CHARS - 3] + "..."
-  return f"{_where(error.absolute_path)}: {message}"
+  where = _where(error.absolute_path)
+  extra = error.validator == "additionalProperties" or (
+      list(error.schema_path)[-2:] == ["additionalProperties", "type"]
+      and error.validator_value == "object")  # An extra field that is not a section.
+  if extra:
+    return _shortened(f"{where}: unknown field (extra fields must be sections, JSON objects): "
+                      f"{error.message}")
+  return f"{where}: {_shortened(error.message)}"
 
 
 def _check_finite(value: object, source: str, path: tuple = ()) -> None:

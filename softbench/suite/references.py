@@ -12,21 +12,23 @@ towards a point moving in the planar actuation space of ``SoftArm.planar_action`
   use, so the poses are held out from every training set (the paper's "test babbling").
 
 References are cached under ``softbench_home()/references``, keyed by a hash of everything that
-generates them (the robot's MJCF included), with a content hash checked on every load. The
-generating actions are stored for replay checks; tasks show controllers only the poses.
+generates them (the robot's MJCF included), with a content hash checked on every load; a damaged
+one is reported (``CorruptFileWarning``) and generated again. The generating actions are stored
+for replay checks; tasks show controllers only the poses.
 """
 
 import dataclasses
 import functools
 import hashlib
 import json
-import logging
 import os
+import warnings
 import zipfile
 
 import numpy as np
 
 from softbench import storage
+from softbench.data import dataset
 from softbench.data import seeding
 from softbench.robots import base
 from softbench.robots import recorder
@@ -43,8 +45,6 @@ AMPLITUDE_GRID = np.linspace(0.05, 1.0, 20)  # Actuations tried when calibrating
 SETTLE_SECONDS = 3.0  # (s) Hold per calibration actuation; longer than any settling time.
 SHAPES = ("babbling", "circle", "rectangle", "spiral")
 FORMAT_VERSION = 1
-
-_log = logging.getLogger(__name__)
 
 
 def _phases(length: int, cycles: float) -> np.ndarray:
@@ -130,18 +130,24 @@ def _config(robot: base.SoftArm, shape: str, length: int) -> dict:
 
 
 def _load_cached(path, config: dict) -> Reference | None:
+  """The cached reference at ``path`` if it is intact and made with ``config``; None if absent,
+  or with a ``CorruptFileWarning`` if damaged (it is then generated again)."""
   meta_path = path.with_suffix(".json")
   if not path.exists() or not meta_path.exists():
     return None
   try:
     meta = json.loads(meta_path.read_text())
+    if not isinstance(meta, dict):
+      raise ValueError(f"{meta_path.name} is not a JSON object")
     with np.load(path) as stored:
       arrays = {"actions": stored["actions"], "poses": stored["poses"]}
-    if meta["config"] != config or meta["sha256"] != storage.arrays_sha256(arrays):
+    if meta.get("config") != config or meta.get("sha256") != storage.arrays_sha256(arrays):
       raise ValueError("content does not match its hash")
-  except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as error:
-    _log.warning("softbench: cached reference %s is unreadable (%s); generating it again",
-                 path, str(error).splitlines()[0] if str(error) else type(error).__name__)
+  except (OSError, ValueError, TypeError, KeyError, EOFError, RecursionError,
+          zipfile.BadZipFile) as error:
+    why = str(error).splitlines()[0] if str(error) else type(error).__name__
+    warnings.warn(f"{path}: unreadable cached reference ({why}); generating it again",
+                  dataset.CorruptFileWarning, stacklevel=3)
     return None
   return Reference(config["shape"], arrays["actions"], arrays["poses"])
 
