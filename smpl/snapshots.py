@@ -15,23 +15,19 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import os
-import pickle
 import shutil
 import warnings
-import zipfile
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import torch
 
-from smpl.checkpoint import save_atomically
+from smpl.checkpoint import first_line, save_atomically
 
 SAVE_INTERVAL_S = 30.0
 """Least wall time (s) between two snapshots of a fit under way."""
 _FORMAT = "softbench-smpl-fit-snapshot"
-_UNREADABLE = (RuntimeError, EOFError, pickle.UnpicklingError, zipfile.BadZipFile, ValueError,
-               KeyError, TypeError)
 
 
 class _Sequence:
@@ -80,11 +76,12 @@ def load(path: Path, fingerprint: str) -> dict[str, Any] | None:
         payload = torch.load(path, map_location="cpu", weights_only=True)
         if payload["format"] != _FORMAT:
             raise ValueError("not a training snapshot")
-    except _UNREADABLE as error:
-        warnings.warn(f"{path}: unreadable training snapshot ({error}); training that model "
-                      f"from the start", RuntimeWarning, stacklevel=2)
+        matches = payload["fingerprint"] == fingerprint
+    except Exception as error:  # A damaged file raises nearly anything.
+        warnings.warn(f"{path}: unreadable training snapshot ({first_line(error)}); training "
+                      f"that model from the start", RuntimeWarning, stacklevel=2)
         return None
-    if payload["fingerprint"] != fingerprint:
+    if not matches:
         warnings.warn(f"{path}: training snapshot of another config, data or initialisation; "
                       f"training that model from the start", RuntimeWarning, stacklevel=2)
         return None

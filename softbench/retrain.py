@@ -79,15 +79,26 @@ def settings(agent: str = RETRAINED_AGENT, robot: str | None = None, faults: tup
 def _timed_baseline(settings: RetrainSettings, faulty: robots.SoftArm, seed: int,
                     show_progress: bool) -> tuple[agents.Agent, float | None, bool]:
   """The baseline trained on the faulty robot, the wall time of its training and whether it was
-  trained now (the checkpoint did not exist)."""
+  trained now (the checkpoint did not exist, or was damaged and written again)."""
   profile = settings.run.profile
   path = learned.checkpoint_path(settings.baseline, faulty, seed, profile, per_module=False)
-  trained_now = not path.exists()
+  cached = _file_identity(path)
   started = time.perf_counter()
   agent = agents.make(settings.baseline, faulty, seed, profile, show_progress)
+  trained_now = _file_identity(path) != cached
   if trained_now:
     adaptation.write_wall_time(path, round(time.perf_counter() - started, 3))
   return agent, adaptation.read_wall_time(path), trained_now
+
+
+def _file_identity(path: pathlib.Path) -> tuple[int, int] | None:
+  """The file's inode and modification time (ns), which a checkpoint written again changes; None
+  if there is none."""
+  try:
+    status = path.stat()
+  except OSError:
+    return None
+  return status.st_ino, status.st_mtime_ns
 
 
 def _seed(settings: RetrainSettings, seed: int, show_progress: bool) -> dict:

@@ -13,8 +13,11 @@ from smpl import snapshots
 from smpl import training
 from softbench import agents
 from softbench import cli
+from softbench import data
 from softbench import evaluation
+from softbench import profiles
 from softbench import protocols
+from softbench import robots
 from softbench import run
 from softbench import suite
 from softbench.agents import forward_models
@@ -79,8 +82,61 @@ def test_checkpoint_round_trip_gives_identical_actions(agent_name, tmp_path, mon
   loaded = episode(agent_name, "tendon-2", "circle")
   np.testing.assert_array_equal(trained.actions, loaded.actions)
   checkpoint.write_bytes(checkpoint.read_bytes()[:1000])
-  with pytest.raises(ValueError, match="not a readable checkpoint"):
-    agents.make(agent_name, "tendon-2", 0, "tiny")
+  # A damaged cached checkpoint is reported in one line and trained again, to the same weights.
+  with pytest.warns(data.CorruptFileWarning) as caught:
+    retrained = episode(agent_name, "tendon-2", "circle")
+  assert_one_line_retraining(caught, checkpoint)
+  np.testing.assert_array_equal(retrained.actions, trained.actions)
+  with warnings.catch_warnings():
+    warnings.simplefilter("error")  # Written again whole: it loads without a warning.
+    np.testing.assert_array_equal(episode(agent_name, "tendon-2", "circle").actions,
+                                  trained.actions)
+  assert [path.name for path in checkpoint.parent.iterdir()] == [checkpoint.name]
+
+
+def assert_one_line_retraining(caught, path):
+  """``caught`` holds one warning: one line naming ``path`` and saying it is trained again."""
+  (warning,) = [entry for entry in caught if issubclass(entry.category, data.CorruptFileWarning)]
+  message = str(warning.message)
+  assert str(path) in message and "training it again" in message and "\n" not in message
+
+
+@pytest.mark.parametrize("damage", ["hello", "flipped weight"])
+def test_a_damaged_cached_forward_model_is_trained_again(damage, tmp_path, monkeypatch):
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
+  agents.make("mlp", "tendon-2", 0, "tiny")
+  (forward,) = (tmp_path / forward_models.FOLDER).glob("*.pt")
+  (checkpoint,) = (tmp_path / learned.CHECKPOINT_FOLDER).glob("mlp-*.pt")
+  written = torch.load(checkpoint, weights_only=True)["state_dict"]
+  checkpoint.unlink()  # The agent trains again, from the cached forward model.
+  content = bytearray(forward.read_bytes())
+  if damage == "hello":
+    content = bytearray(b"hello")
+  else:  # One bit of the largest weight tensor: only the content hash notices.
+    state = torch.load(forward, weights_only=True)["state_dict"]
+    values = state[max(state, key=lambda name: state[name].numel())].numpy().tobytes()
+    content[bytes(content).index(values) + 2] ^= 0x01
+  forward.write_bytes(bytes(content))
+  with pytest.warns(data.CorruptFileWarning) as caught:
+    agents.make("mlp", "tendon-2", 0, "tiny")
+  assert_one_line_retraining(caught, forward)
+  again = torch.load(checkpoint, weights_only=True)["state_dict"]
+  assert again.keys() == written.keys()
+  assert all(torch.equal(again[name], written[name]) for name in again)
+  with warnings.catch_warnings():
+    warnings.simplefilter("error")
+    agents.make("mlp", "tendon-2", 0, "tiny")
+
+
+def test_a_folder_at_a_checkpoint_path_is_a_one_line_error_and_stays(tmp_path, monkeypatch):
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
+  path = learned.checkpoint_path("mlp", robots.make("tendon-2"), 0, profiles.get("tiny"), False)
+  (path / "kept.txt").parent.mkdir(parents=True)
+  (path / "kept.txt").write_text("not ours")
+  with pytest.raises(ValueError, match="a folder") as raised:
+    agents.make("mlp", "tendon-2", 0, "tiny")
+  assert str(path) in str(raised.value) and "\n" not in str(raised.value)
+  assert (path / "kept.txt").read_text() == "not ours"
 
 
 @pytest.mark.parametrize("agent_name", LEARNED_AGENTS)

@@ -11,10 +11,14 @@ import torch
 
 from softbench import agents
 from softbench import cli
+from softbench import data
 from softbench import profiles
+from softbench import retrain
 from softbench import robots
+from softbench import storage
 from softbench import suite
 from softbench.agents import adaptation
+from softbench.agents import learned
 from softbench.robots import faults
 
 STEPS_BEFORE = 60  # Physics steps under a random action, so that forces are read in a bent state.
@@ -250,3 +254,36 @@ def test_cli_retrain_end_to_end(tmp_path, capsys):
   assert record["per_seed"] == fault["conditions"]["retrained"]["per_seed"]
   (written,) = (tmp_path / "results").glob("smpl-retrain-tendon-2-fault2.0.0.3-spiral-tiny-*.json")
   assert json.loads(written.read_text()) == record
+
+
+def test_a_damaged_retrained_column_is_trained_again():
+  healthy = robots.make("tendon-2")
+  faulty = healthy.with_faults([faults.parse("1:0:0.5")])
+  smpl = agents.make("smpl", healthy, 0, "tiny")
+  first = adaptation.retrain_column(smpl, faulty, profiles.get("tiny"))  # Trained or cached.
+  (path,) = (storage.softbench_home() / learned.CHECKPOINT_FOLDER).glob(
+      "smpl-tendon-2-fault1.0.0.5-*.pt")
+  path.write_bytes(b"hello")
+  with pytest.warns(data.CorruptFileWarning) as caught:
+    again = adaptation.retrain_column(smpl, faulty, profiles.get("tiny"))
+  (warning,) = [entry for entry in caught if issubclass(entry.category, data.CorruptFileWarning)]
+  assert str(path) in str(warning.message) and "\n" not in str(warning.message)
+  assert again.trained_now and again.wall_time_s == adaptation.read_wall_time(path)
+  assert _state(first.agent.inverse).keys() == again.agent.inverse.state_dict().keys()
+  assert all(torch.equal(tensor, again.agent.inverse.state_dict()[name])
+             for name, tensor in _state(first.agent.inverse).items())  # Deterministic retraining.
+  assert not adaptation.retrain_column(smpl, faulty, profiles.get("tiny")).trained_now
+
+
+def test_the_baselines_timing_notices_a_damaged_checkpoint_trained_again():
+  settings = retrain.settings(robot="tendon-2", faults=("2:0:0.3",), profile="tiny", seeds=1)
+  faulty = robots.make("tendon-2").with_faults(settings.run.faults)
+  retrain._timed_baseline(settings, faulty, 0, False)  # Trained, or found in the shared home.
+  _, seconds, trained_now = retrain._timed_baseline(settings, faulty, 0, False)
+  assert not trained_now
+  path = learned.checkpoint_path(settings.baseline, faulty, 0, settings.run.profile,
+                                 per_module=False)
+  path.write_bytes(path.read_bytes()[:500])
+  with pytest.warns(data.CorruptFileWarning):
+    _, seconds, trained_now = retrain._timed_baseline(settings, faulty, 0, False)
+  assert trained_now and seconds == adaptation.read_wall_time(path) and seconds > 0

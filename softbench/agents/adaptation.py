@@ -139,7 +139,10 @@ def retrain_column(agent: learned.LearnedAgent, faulty_robot: robot_base.SoftArm
   forwards = [copy.deepcopy(controller.forward).freeze() for controller in agent.controllers]
   bundle = torch.nn.ModuleDict({"inverse": inverse,
                                 "forward_models": torch.nn.ModuleList(forwards)})
-  trained_now = not path.exists()
+  # A damaged cached file is reported (data.CorruptFileWarning) and trained again; a refused file
+  # leaves the bundle untouched, so the retraining starts from the healthy weights.
+  trained_now = not path.exists() or checkpoint.load_cached(
+      path, bundle, config, data.CorruptFileWarning) is None
   if trained_now:
     dataset = data.collect(faulty_robot, samples=profile.samples, seed=learned.DATA_SEED,
                            progress=show_progress)
@@ -149,7 +152,6 @@ def retrain_column(agent: learned.LearnedAgent, faulty_robot: robot_base.SoftArm
     checkpoint.save_checkpoint(path, bundle, config)
     write_wall_time(path, wall_time)
   else:
-    checkpoint.load_checkpoint(path, bundle, config)
     wall_time = read_wall_time(path)
   inverse.cpu().requires_grad_(False).eval()
   controllers = [learned.Controller(controller.view, forward.cpu().eval(),

@@ -7,7 +7,8 @@ baselines' whole-arm model) and every trial of a tuning study share one: trained
 ``softbench.protocols.prepare_column`` trains it, cached under ``$SOFTBENCH_HOME/forward`` by a
 hash of everything its weights depend on (``ForwardModelConfig``), and loaded with the weights a
 fresh training gives, to the bit. An interrupted training resumes from its snapshots
-(``smpl.snapshots``, in the cache file's ``.partial`` folder).
+(``smpl.snapshots``, in the cache file's ``.partial`` folder); a damaged cache file is reported
+and trained again.
 """
 
 import contextlib
@@ -70,11 +71,9 @@ def prepare(robot: robot_base.SoftArm, views: list[data.View], dataset: data.Dat
                              training_version)
     path = cache_file(key)
     partial = path.with_suffix(".partial")  # Its training snapshots until it is saved.
-    if path.exists():
-      split = data.windows(dataset, view)
-      model = smpl_forward.ForwardModel(split.train.actuation_size, split.train.pose_size)
-      checkpoint.load_checkpoint(path, model, key)
-      model.freeze()
+    cached = _load(path, key, dataset, view) if path.exists() else None
+    if cached:
+      split, model = cached
     else:
       with snapshots.resumable(partial), (
           progress.EpochProgressBar(f"{progress_label} {view.name}", config.max_epochs)
@@ -87,3 +86,14 @@ def prepare(robot: robot_base.SoftArm, views: list[data.View], dataset: data.Dat
     windows.append(split)
     forwards.append(model.eval())
   return windows, forwards
+
+
+def _load(path: pathlib.Path, key: ForwardModelConfig, dataset: data.Dataset, view: data.View
+          ) -> tuple[data.SplitWindows, smpl_forward.ForwardModel] | None:
+  """The view's windows and the frozen forward model cached at ``path``, or None if the file
+  fails its checks (reported with a ``data.CorruptFileWarning``, for training it again)."""
+  split = data.windows(dataset, view)
+  model = smpl_forward.ForwardModel(split.train.actuation_size, split.train.pose_size)
+  if checkpoint.load_cached(path, model, key, data.CorruptFileWarning) is None:
+    return None
+  return split, model.freeze()

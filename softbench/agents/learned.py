@@ -36,6 +36,7 @@ import contextlib
 import dataclasses
 import hashlib
 import pathlib
+import warnings
 from typing import Callable
 
 import numpy as np
@@ -399,19 +400,29 @@ def load_or_train(path: pathlib.Path, config, parts: list[str],
                   untrained_models: Callable[[], tuple[InverseModel,
                                                        list[smpl_forward.ForwardModel]]],
                   train: Callable[[], TrainedModels]) -> TrainedModels:
-  """The models of the checkpoint at ``path`` (saved for ``config``) when it exists, loaded into
-  ``untrained_models()``. Otherwise ``train()``'s, trained so that an interrupted training resumes
+  """The models of the checkpoint at ``path`` (saved for ``config``) when it exists and passes its
+  checks, loaded into ``untrained_models()``. Otherwise ``train()``'s (a damaged checkpoint is
+  reported with a ``data.CorruptFileWarning``), trained so that an interrupted training resumes
   (snapshots in ``snapshot_folder(path)``) and then saved there: normalisation i as
   ``parts[i]/KEY``, the further arrays under their own names (no part's prefix)."""
+  stored = None
   if path.exists():
     inverse, forwards = untrained_models()
-    stored = checkpoint.load_checkpoint(path, bundle(inverse, forwards), config)
-    normalisations = [data.Normalisation.from_arrays(
-        {key.removeprefix(f"{part}/"): value for key, value in stored.items()
-         if key.startswith(f"{part}/")}) for part in parts]
-    arrays = {key: np.asarray(value) for key, value in stored.items()
-              if key.split("/")[0] not in parts}
-    return TrainedModels(inverse, forwards, normalisations, arrays)
+    stored = checkpoint.load_cached(path, bundle(inverse, forwards), config,
+                                    data.CorruptFileWarning)
+  if stored is not None:
+    try:
+      normalisations = [data.Normalisation.from_arrays(
+          {key.removeprefix(f"{part}/"): value for key, value in stored.items()
+           if key.startswith(f"{part}/")}) for part in parts]
+    except (KeyError, ValueError, TypeError) as error:  # Damaged where no hash checks it (a file
+      # written before checkpoints had one): train again.
+      warnings.warn(f"{path}: normalisation unusable ({checkpoint.first_line(error)}); training "
+                    "it again", data.CorruptFileWarning, stacklevel=2)
+    else:
+      arrays = {key: np.asarray(value) for key, value in stored.items()
+                if key.split("/")[0] not in parts}
+      return TrainedModels(inverse, forwards, normalisations, arrays)
   with snapshots.resumable(snapshot_folder(path)):
     models = train()
   if set(key.split("/")[0] for key in models.arrays) & set(parts):

@@ -62,7 +62,7 @@ class DatasetError(ValueError):
 
 
 class CorruptFileWarning(UserWarning):
-  """A saved chunk or dataset failed its checks and is computed again."""
+  """A saved chunk, dataset or checkpoint failed its checks and is computed again."""
 
 
 @dataclasses.dataclass(frozen=True, eq=False)

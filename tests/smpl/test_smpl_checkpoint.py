@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import torch
 
-from smpl.checkpoint import CheckpointError, load_checkpoint, save_checkpoint
+from smpl.checkpoint import CheckpointError, load_cached, load_checkpoint, save_checkpoint
 from smpl.progressive import ProgressiveLSTM
 
 
@@ -95,3 +95,128 @@ def test_a_failed_save_keeps_the_previous_checkpoint(tmp_path: Path) -> None:
 def test_missing_file_raises_file_not_found(tmp_path: Path) -> None:
     with pytest.raises(FileNotFoundError):
         load_checkpoint(tmp_path / "absent.pt", _network(), _network().config)
+
+
+def _assert_one_line_naming(error: BaseException, path: Path) -> None:
+    assert isinstance(error, CheckpointError)
+    assert str(path) in str(error) and "\n" not in str(error)
+
+
+def _weights(network: torch.nn.Module) -> dict[str, torch.Tensor]:
+    return {name: tensor.clone() for name, tensor in network.state_dict().items()}
+
+
+def _same(first: dict[str, torch.Tensor], second: dict[str, torch.Tensor]) -> bool:
+    return first.keys() == second.keys() and all(torch.equal(first[k], second[k]) for k in first)
+
+
+@pytest.mark.parametrize("content", [b"hello", b"", b"PK\x03\x04" + bytes(40)])
+def test_bytes_that_are_no_checkpoint_give_a_one_line_error(tmp_path: Path, content) -> None:
+    # b"hello" used to escape from torch.load as KeyError: 101.
+    path = tmp_path / "smpl.pt"
+    path.write_bytes(content)
+    with pytest.raises(CheckpointError) as raised:
+        load_checkpoint(path, _network(), _network().config)
+    _assert_one_line_naming(raised.value, path)
+
+
+def test_a_folder_at_the_path_gives_a_one_line_error_and_stays(tmp_path: Path) -> None:
+    path = tmp_path / "smpl.pt"
+    (path / "inside").mkdir(parents=True)
+    with pytest.raises(CheckpointError) as raised:
+        load_checkpoint(path, _network(), _network().config)
+    _assert_one_line_naming(raised.value, path)
+    with pytest.raises(CheckpointError, match="a folder") as raised:
+        load_cached(path, _network(), _network().config)
+    _assert_one_line_naming(raised.value, path)
+    assert (path / "inside").is_dir()  # Not ours to delete.
+
+
+def test_a_flipped_byte_in_the_weights_fails_the_hash(tmp_path: Path) -> None:
+    path, network = _saved(tmp_path)
+    content = bytearray(path.read_bytes())
+    state = network.state_dict()
+    values = state[max(state, key=lambda name: state[name].numel())].numpy().tobytes()
+    offset = bytes(content).find(values)
+    assert offset > 0 and bytes(content).find(values, offset + 1) == -1
+    content[offset + 5] ^= 0x01  # One bit of one weight's mantissa.
+    path.write_bytes(bytes(content))
+    untouched = _network()
+    before = _weights(untouched)
+    with pytest.raises(CheckpointError, match="differ from their sha256") as raised:
+        load_checkpoint(path, untouched, network.config)
+    _assert_one_line_naming(raised.value, path)
+    assert _same(_weights(untouched), before)  # A refused file leaves the model as it was.
+
+
+def test_a_flipped_byte_in_the_normalisation_fails_the_hash(tmp_path: Path) -> None:
+    path, network = _saved(tmp_path)
+    content = bytearray(path.read_bytes())
+    offset = bytes(content).find(NORMALISATION["pose_low"].tobytes())
+    assert offset > 0
+    content[offset + 3] ^= 0x10
+    path.write_bytes(bytes(content))
+    with pytest.raises(CheckpointError, match="sha256"):
+        load_checkpoint(path, _network(), network.config)
+
+
+def test_a_checkpoint_written_before_the_hash_still_loads(tmp_path: Path) -> None:
+    # Cached checkpoints of the old layout (no sha256 field, same format version) stay valid.
+    path, network = _saved(tmp_path)
+    payload = torch.load(path, weights_only=True)
+    assert isinstance(payload.pop("sha256"), str)
+    torch.save(payload, path)
+    restored = ProgressiveLSTM.from_config(network.config)
+    normalisation = load_checkpoint(path, restored, network.config)
+    assert _same(_weights(restored), _weights(network))
+    np.testing.assert_array_equal(normalisation["pose_low"], NORMALISATION["pose_low"])
+
+
+def test_an_unknown_field_is_refused(tmp_path: Path) -> None:
+    # E.g. the hash field's name damaged: the file must not pass as an unverified old one.
+    path, network = _saved(tmp_path)
+    payload = torch.load(path, weights_only=True)
+    payload["sha257"] = payload.pop("sha256")
+    torch.save(payload, path)
+    with pytest.raises(CheckpointError, match="not a checkpoint's"):
+        load_checkpoint(path, _network(), network.config)
+
+
+def test_damaged_checkpoints_are_refused_or_load_unchanged(tmp_path: Path) -> None:
+    """Truncations and one-byte changes all over the file: each gives a one-line CheckpointError
+    or (a byte that nothing reads) the saved weights and normalisation, never anything else."""
+    path, network = _saved(tmp_path)
+    intact = path.read_bytes()
+    expected = _weights(network)
+    damaged = [intact[:length] for length in range(0, len(intact), max(1, len(intact) // 60))]
+    for offset in range(0, len(intact), max(1, len(intact) // 300)):
+        flipped = bytearray(intact)
+        flipped[offset] ^= 0xFF
+        damaged.append(bytes(flipped))
+    refused = 0
+    for content in damaged:
+        path.write_bytes(content)
+        model = _network()
+        try:
+            normalisation = load_checkpoint(path, model, network.config)
+        except CheckpointError as error:
+            _assert_one_line_naming(error, path)
+            refused += 1
+            continue
+        assert _same(_weights(model), expected)
+        for name, values in NORMALISATION.items():
+            np.testing.assert_array_equal(normalisation[name], values)
+    assert refused > len(damaged) // 2
+
+
+def test_load_cached_warns_in_one_line_and_gives_none_for_a_damaged_file(tmp_path: Path) -> None:
+    path, network = _saved(tmp_path)
+    assert load_cached(tmp_path / "absent.pt", _network(), network.config) is None
+    restored = ProgressiveLSTM.from_config(network.config)
+    assert load_cached(path, restored, network.config).keys() == NORMALISATION.keys()
+    path.write_bytes(b"hello")
+    with pytest.warns(UserWarning) as caught:
+        assert load_cached(path, _network(), network.config, UserWarning) is None
+    (warning,) = caught
+    message = str(warning.message)
+    assert str(path) in message and "training it again" in message and "\n" not in message

@@ -142,3 +142,20 @@ def test_unusable_snapshot_is_ignored_with_a_warning(spoil, tmp_path):
     result = train_forward(resumed, config=config)
   assert same_weights(fresh, resumed)
   assert result.history[0].validation_loss == expected.history[0].validation_loss
+
+
+@pytest.mark.parametrize("content", ["object", "hello"])
+def test_an_unreadable_snapshot_is_reported_in_one_line(content, tmp_path):
+  # torch refuses a pickled object with a message of several paragraphs; b"hello" makes it raise
+  # KeyError: 101.
+  snapshot = tmp_path / "fit-1.pt"
+  if content == "object":
+    torch.save({"format": "softbench-smpl-fit-snapshot", "state": Interrupted()}, snapshot)
+  else:
+    snapshot.write_bytes(b"hello")
+  with pytest.warns(RuntimeWarning) as caught:
+    assert snapshots.load(snapshot, "fingerprint") is None
+  (warning,) = caught
+  message = str(warning.message)
+  assert str(snapshot) in message and "from the start" in message
+  assert "\n" not in message and "\x1b" not in message
