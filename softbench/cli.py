@@ -10,16 +10,19 @@ from softbench import adaptive
 from softbench import agents
 from softbench import continual
 from softbench import data
+from softbench import episode_snapshots
 from softbench import leaderboard
 from softbench import plots
 from softbench import profiles
 from softbench import retrain as retrain_module
 from softbench import robots
 from softbench import run as run_module
+from softbench import storage
 from softbench import suite
 from softbench import tuning
 from softbench.adaptive import plot as adaptive_plot
 from softbench.agents import hyperparameters
+from softbench.data import dataset
 from softbench.data import seeding
 from softbench.rendering import options as video_options
 from softbench.rendering import replay as episode_replay
@@ -77,11 +80,11 @@ def _tasks(args: argparse.Namespace) -> None:
 
 
 def _collect(args: argparse.Namespace) -> None:
-  dataset = data.collect(args.robot, samples=args.samples, seed=args.seed, workers=args.workers)
-  seconds = dataset.collection.get("wall_time_s")
-  print(f"{dataset.robot_name}: {dataset.samples} samples in {dataset.num_episodes} episodes"
+  collected = data.collect(args.robot, samples=args.samples, seed=args.seed, workers=args.workers)
+  seconds = collected.collection.get("wall_time_s")
+  print(f"{collected.robot_name}: {collected.samples} samples in {collected.num_episodes} episodes"
         + (f" (collection took {seconds:.1f} s)" if seconds is not None else ""))
-  print(dataset.path)
+  print(collected.path)
 
 
 def _agents(args: argparse.Namespace) -> None:
@@ -171,11 +174,25 @@ def _number(name: str, text: str, kind: type) -> int | float:
     raise ValueError(f"{name} must be a number, got {text!r}") from None
 
 
+# The video flags (``_add_video_arguments``), their attributes and defaults.
+_VIDEO_FLAGS = (("--width", "width", str(video_options.DEFAULT_WIDTH)),
+                ("--height", "height", str(video_options.DEFAULT_HEIGHT)),
+                ("--fps", "fps", f"{video_options.DEFAULT_FPS:g}"),
+                ("--camera", "camera", video_options.DEFAULT_CAMERA),
+                ("--frames-per-step", "frames_per_step", "1"))
+
+
 def _video_options(args: argparse.Namespace) -> video_options.VideoOptions:
+  given = {name: default if getattr(args, name) is None else getattr(args, name)
+           for _, name, default in _VIDEO_FLAGS}
   return video_options.VideoOptions(
-      _number("width", args.width, int), _number("height", args.height, int),
-      _number("fps", args.fps, float), args.camera,
-      _number("frames per step", args.frames_per_step, int))
+      _number("width", given["width"], int), _number("height", given["height"], int),
+      _number("fps", given["fps"], float), given["camera"],
+      _number("frames per step", given["frames_per_step"], int))
+
+
+def _video_flags_given(args: argparse.Namespace) -> list[str]:
+  return [flag for flag, name, _ in _VIDEO_FLAGS if getattr(args, name) is not None]
 
 
 def _write_video(settings: run_module.RunSettings, seed: int, episode, path: pathlib.Path,
@@ -189,6 +206,9 @@ def _write_video(settings: run_module.RunSettings, seed: int, episode, path: pat
 
 
 def _run(args: argparse.Namespace) -> None:
+  if args.video is None and _video_flags_given(args):
+    raise ValueError(f"{', '.join(_video_flags_given(args))} go with --video FILE.mp4")
+  _check_record_arguments(args)
   if args.protocol is not None:
     return _run_protocol(args)
   if args.task is None:
@@ -201,15 +221,16 @@ def _run(args: argparse.Namespace) -> None:
   if args.video:
     options = _video_options(args)
     video_path = video_options.check_video_path(args.video)
-  record, episodes = run_module.execute_episodes(settings)
+  record, episodes = run_module.execute_episodes(settings, keep_seeds=True)
   print(run_module.table(record))
   path = run_module.record_path(record, pathlib.Path(args.results))
   run_module.write_record(record, path)
   print(f"result record: {path}")
-  if settings.adaptive:
-    print(f"plot: {adaptive_plot.write(record, path.with_suffix('.png'))}")
   if args.json:
     run_module.write_record(record, pathlib.Path(args.json))
+  episode_snapshots.discard(settings)  # Only now: a failed write leaves a run that resumes.
+  if settings.adaptive:
+    print(f"plot: {adaptive_plot.write(record, path.with_suffix('.png'))}")
   for plot in plots.save_run_plots(path, record, episodes) if episodes else ():
     print(f"plot: {plot}")
   if args.video:  # Once the record is safe; then the record links the video.
@@ -231,17 +252,17 @@ def _render(args: argparse.Namespace) -> None:
 
 
 def _add_video_arguments(parser: argparse.ArgumentParser) -> None:
-  parser.add_argument("--width", default=str(video_options.DEFAULT_WIDTH),
+  """The flags of ``_VIDEO_FLAGS``; left out, they are None (``_video_options`` fills in)."""
+  parser.add_argument("--width",
                       help=f"frame width in pixels, even (default {video_options.DEFAULT_WIDTH})")
-  parser.add_argument("--height", default=str(video_options.DEFAULT_HEIGHT),
+  parser.add_argument("--height",
                       help=f"frame height in pixels, even (default "
                            f"{video_options.DEFAULT_HEIGHT})")
-  parser.add_argument("--fps", default=f"{video_options.DEFAULT_FPS:g}",
-                      help=f"frames per second (default {video_options.DEFAULT_FPS:g})")
-  parser.add_argument("--camera", default=video_options.DEFAULT_CAMERA,
+  parser.add_argument("--fps", help=f"frames per second (default {video_options.DEFAULT_FPS:g})")
+  parser.add_argument("--camera",
                       help=f"one of {', '.join(video_options.CAMERAS)} (default "
                            f"{video_options.DEFAULT_CAMERA})")
-  parser.add_argument("--frames-per-step", default="1",
+  parser.add_argument("--frames-per-step",
                       help="frames per control step, to show the motion within each step "
                            "(default 1: the pose at the end of every step)")
 
@@ -263,6 +284,13 @@ def _add_record_arguments(parser: argparse.ArgumentParser) -> None:
   parser.add_argument("--json", help="also write the result record to this file")
 
 
+def _check_record_arguments(args: argparse.Namespace) -> None:
+  """Refuses a ``--results`` or ``--json`` that could not be written, before the run."""
+  storage.check_writable(args.results, "result records to", folder=True)
+  if args.json:
+    storage.check_writable(args.json, "result record")
+
+
 def _leaderboard(args: argparse.Namespace) -> None:
   results = pathlib.Path(args.results)
   board = leaderboard.build(results)
@@ -275,6 +303,7 @@ def _leaderboard(args: argparse.Namespace) -> None:
 def _retrain(args: argparse.Namespace) -> None:
   settings = retrain_module.settings(args.agent, args.robot, tuple(args.fault), args.profile,
                                      args.task, args.seeds, args.baseline)
+  _check_record_arguments(args)
   record = retrain_module.execute(settings)
   print(retrain_module.table(record))
   path = retrain_module.record_path(record, pathlib.Path(args.results))
@@ -451,10 +480,10 @@ def main(argv: list[str] | None = None) -> int:
     with run_module.sigterm_as_interrupt():
       args.run(args)
   except (ValueError, FileNotFoundError, FloatingPointError, video.RenderingUnavailable) as error:
-    print(f"softbench: error: {error}", file=sys.stderr)
+    print(f"softbench: error: {dataset.first_line(error)}", file=sys.stderr)
     return EXIT_USAGE
-  except run_module.WorkerDied as error:
-    print(f"softbench: error: {error}", file=sys.stderr)
+  except (run_module.WorkerDied, video.RenderingFailed) as error:
+    print(f"softbench: error: {dataset.first_line(error)}", file=sys.stderr)
     return EXIT_FAILURE
   except KeyboardInterrupt:
     print("softbench: interrupted; run the same command again to resume", file=sys.stderr)
@@ -462,7 +491,18 @@ def main(argv: list[str] | None = None) -> int:
   except BrokenPipeError:  # The reader went away (softbench leaderboard | head).
     os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
     return EXIT_FAILURE
+  except OSError as error:  # A file or folder that cannot be read or written, a full disk.
+    print(f"softbench: error: {_describe_os_error(error)}", file=sys.stderr)
+    return EXIT_FAILURE
   return 0
+
+
+def _describe_os_error(error: OSError) -> str:
+  """``error`` in one line: the file and the system's reason when it names them."""
+  if error.filename is None or not error.strerror:
+    return str(error).splitlines()[0] if str(error) else type(error).__name__
+  target = f" -> {error.filename2}" if error.filename2 is not None else ""
+  return f"{error.filename}{target}: {error.strerror}"
 
 
 if __name__ == "__main__":

@@ -46,6 +46,7 @@ from softbench.agents import learned
 from softbench.data import dataset
 from softbench.leaderboard import records
 from softbench.suite import reach
+from softbench.suite import trajectories
 from softbench.robots import faults as fault_model
 
 PAPER_ROBOT = {"babbling": "tendon-3", "circle": "tendon-3", "rectangle": "tendon-3",
@@ -84,10 +85,11 @@ def settings(task: str, agent: str, robot: str | None = None, seeds: int | None 
 
   Raises:
     ValueError: unknown task, agent, robot, profile or eval mode, seeds < 1, a trajectory
-      without the custom task or the custom task without one, a module with another task than
-      reach or out of range, adaptive with another task than reach, a non-learned agent or
-      more than one seed, targets or helpers without adaptive, targets < 1, unknown helpers,
-      a malformed fault or one that names no actuator of the robot (one line).
+      without the custom task or the custom task without one, an unreadable or malformed
+      trajectory file, a module with another task than reach or out of range, adaptive with
+      another task than reach, a non-learned agent or more than one seed, targets or helpers
+      without adaptive, targets < 1, unknown helpers, a malformed fault or one that names no
+      actuator of the robot (one line).
   """
   suite.describe(task)
   agents.describe(agent)
@@ -105,6 +107,8 @@ def settings(task: str, agent: str, robot: str | None = None, seeds: int | None 
                      f"{', '.join(learned.ERROR_SOURCES)}")
   if (trajectory is None) == (task == "custom"):
     raise ValueError("--trajectory goes with --task custom, and --task custom needs one")
+  if trajectory is not None:  # Read now: a bad file is refused before any collection or training.
+    trajectories.load_trajectory(trajectory, robots.make(robot))
   if adaptive:
     targets = adaptive_activation.DEFAULT_TARGETS if targets is None else targets
     helpers = adaptive_activation.experiment.DEFAULT_HELPERS if helpers is None else helpers
@@ -326,10 +330,12 @@ def execute(run: RunSettings, show_progress: bool = True, workers: int | None = 
   return execute_episodes(run, show_progress, workers)[0]
 
 
-def execute_episodes(run: RunSettings, show_progress: bool = True, workers: int | None = None
-                     ) -> tuple[dict, list[evaluation.Episode]]:
+def execute_episodes(run: RunSettings, show_progress: bool = True, workers: int | None = None,
+                     keep_seeds: bool = False) -> tuple[dict, list[evaluation.Episode]]:
   """``execute``, also returning every seed's episode (in seed order) for plots and videos;
-  none for an adaptive run (``softbench.adaptive`` draws its own figure)."""
+  none for an adaptive run (``softbench.adaptive`` draws its own figure). The finished seeds
+  kept for resuming are discarded at the end unless ``keep_seeds``: then the caller discards
+  them (``episode_snapshots.discard``) once the record is safely written."""
   started, origin = time.perf_counter(), provenance()
   arm = robots.make(run.robot)
   if agents.describe(run.agent).learned:
@@ -347,7 +353,8 @@ def execute_episodes(run: RunSettings, show_progress: bool = True, workers: int 
             f"interrupted", file=sys.stderr)
     outcomes = over_seeds(_run_seed, run.seeds, (run,), f"{run.agent} on {run.task}",
                           show_progress, workers)
-    episode_snapshots.discard(run)
+    if not keep_seeds:
+      episode_snapshots.discard(run)
     results = {"scored_modules": list(outcomes[0][1].scored_modules),
                "per_seed": [entry for entry, _ in outcomes]}
   record = {

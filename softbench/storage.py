@@ -48,6 +48,32 @@ def write_atomically(path: pathlib.Path, content: str | bytes) -> None:
     raise
 
 
+def check_writable(path: str | os.PathLike, what: str, folder: bool = False) -> pathlib.Path:
+  """``path`` as a ``Path`` if ``what`` (e.g. "video") can be written there: a file (or, with
+  ``folder``, a folder of files) whose missing parent folders can be made. Checked before long
+  work, so that it does not end in a failed write.
+
+  Raises:
+    ValueError: ``path`` is a folder where a file is wanted or the other way round, a parent is
+      a file, or there is no permission to write (one line).
+  """
+  path = pathlib.Path(path)
+  if path.exists() and path.is_dir() != folder:
+    raise ValueError(f"cannot write {what} {str(path)!r}: it is "
+                     f"{'a file' if folder else 'a folder'}")
+  ancestor = path.absolute() if folder else path.absolute().parent
+  while not ancestor.exists():
+    ancestor = ancestor.parent
+  if not ancestor.is_dir():
+    raise ValueError(f"cannot write {what} {str(path)!r}: {str(ancestor)!r} is not a folder")
+  if not os.access(ancestor, os.W_OK | os.X_OK):
+    raise ValueError(f"cannot write {what} {str(path)!r}: no permission to write in "
+                     f"{str(ancestor)!r}")
+  if not folder and path.exists() and not os.access(path, os.W_OK):
+    raise ValueError(f"cannot write {what} {str(path)!r}: the file is read-only")
+  return path
+
+
 def _umask() -> int:
   current = os.umask(0)
   os.umask(current)

@@ -72,6 +72,15 @@ def test_cli_refuses_bad_input_with_one_line_and_exit_code_2(argv, capsys):
     robots.make(argv[1], **({"module_length": -0.05} if len(argv) > 2 else {}))
 
 
+@pytest.mark.parametrize("length", ["80", "1e-6", "1e9"])
+def test_cli_refuses_a_module_length_out_of_range(length, capsys):
+  # 80 is a typo for 80 mm; 1e-6 m made MuJoCo's two-line compile error.
+  assert cli.main(["robots", "pneumatic-433", "--module-length", length]) == cli.EXIT_USAGE
+  captured = capsys.readouterr()
+  assert captured.out == ""
+  assert captured.err.count("\n") == 1 and "module_length must lie between" in captured.err
+
+
 def test_cli_lists_every_task_and_the_control_periods(capsys):
   assert cli.main(["tasks"]) == 0
   out = capsys.readouterr().out
@@ -99,6 +108,7 @@ def test_cli_collects_a_dataset_then_finds_it(tmp_path, monkeypatch, capsys):
     ["collect", "--robot", "tendon-2", "--samples", "0"],
     ["collect", "--robot", "tendon-2", "--seed", "-1"],
     ["collect", "--robot", "tendon-2", "--workers", "0"],
+    ["collect", "--robot", "tendon-2", "--samples", "100000000000000"],  # Would fill the memory.
 ])
 def test_cli_collect_refuses_bad_input(argv, capsys, tmp_path, monkeypatch):
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))

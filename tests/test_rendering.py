@@ -214,3 +214,14 @@ def test_cli_refuses_unwritable_video_paths(out, message, tmp_path, capsys):
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and message in lines[0]
   assert not list(tmp_path.glob("*.json"))
+
+
+def test_a_backend_failing_while_rendering_is_one_line(tmp_path, capsys, monkeypatch):
+  def failing(*args, **kwargs):
+    raise video.RenderingFailed("rendering with egl failed: GL context lost")
+
+  monkeypatch.setattr(video, "render", failing)
+  assert cli.main([*RENDER, "--out", str(tmp_path / "a.mp4")]) == cli.EXIT_FAILURE
+  lines = capsys.readouterr().err.strip().splitlines()
+  assert lines[-1] == "softbench: error: rendering with egl failed: GL context lost"
+  assert not any(line.startswith("Traceback") for line in lines)

@@ -5,6 +5,7 @@ import dataclasses
 
 import pytest
 
+from softbench import cli
 from softbench import episode_snapshots
 from softbench import run
 
@@ -101,3 +102,21 @@ def test_an_edited_trajectory_file_never_reuses_saved_seeds(tmp_path):
   before = episode_snapshots.folder(custom)
   path.write_text("0.0,0.01,-0.05\n")
   assert episode_snapshots.folder(custom) != before
+
+
+def test_a_failed_record_write_keeps_the_seeds_for_the_next_run(monkeypatch, tmp_path, capsys):
+  argv = ["run", "--task", "circle", "--agent", "random", "--robot", "tendon-1", "--seeds",
+          str(SEEDS), "--profile", "tiny", "--results", str(tmp_path / "records")]
+
+  def disk_full(record, path):
+    raise OSError(28, "No space left on device", str(path))
+
+  with monkeypatch.context() as patch:
+    patch.setattr(run, "write_record", disk_full)
+    assert cli.main(argv) == cli.EXIT_FAILURE
+  assert "No space left on device" in capsys.readouterr().err.strip().splitlines()[-1]
+  assert len(list(episode_snapshots.folder(tiny_run()).glob("seed*.npz"))) == SEEDS
+  assert cli.main(argv) == 0  # Seeds may run in worker processes: the run says what it reused.
+  assert f"resuming: {SEEDS} of {SEEDS} seeds finished" in capsys.readouterr().err
+  assert len(list((tmp_path / "records").glob("*.json"))) == 1
+  assert not episode_snapshots.folder(tiny_run()).exists()

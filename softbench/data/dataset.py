@@ -47,6 +47,8 @@ from softbench.robots import recorder
 FORMAT = "softbench-babbling-dataset"
 FORMAT_VERSION = 1  # Bump whenever the arrays or the way they are generated change.
 DEFAULT_SAMPLES = 14_000  # SPEC section 4: motor-babbling samples per robot configuration.
+MAX_SAMPLES = 10_000_000  # Most samples a dataset may have: 700 times the paper's, 3.2 GB of
+# float64 poses and actions for tendon-5 (40 numbers a sample); more is a typo, not a dataset.
 EPISODE_LENGTH = 1_400  # Samples per episode, at most; 14,000 samples make 10 episodes.
 DATASETS_FOLDER = "datasets"
 NPZ_NAME = "dataset.npz"
@@ -139,6 +141,8 @@ def read_npz(content: bytes, error_type: type[ValueError]) -> dict[str, np.ndarr
 def episode_lengths(samples: int, episode_length: int = EPISODE_LENGTH) -> tuple[int, ...]:
   """Lengths of the fewest episodes of at most ``episode_length`` samples, as even as possible."""
   check_count("samples", samples)
+  if samples > MAX_SAMPLES:  # Before the list of episodes, which would fill the memory.
+    raise ValueError(f"samples must be at most {MAX_SAMPLES:,}, got {samples:,}")
   check_count("episode_length", episode_length)
   episodes = -(-samples // episode_length)
   base, longer = divmod(samples, episodes)

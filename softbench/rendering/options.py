@@ -7,6 +7,8 @@ import numbers
 import os
 import pathlib
 
+from softbench import storage
+
 DEFAULT_WIDTH = 640  # (pixels)
 DEFAULT_HEIGHT = 480  # (pixels)
 DEFAULT_FPS = 30.0  # (frames/s)
@@ -74,16 +76,4 @@ def check_video_path(path: str | os.PathLike) -> pathlib.Path:
   path = pathlib.Path(path)
   if path.suffix.lower() != VIDEO_SUFFIX:
     raise ValueError(f"video file must end in {VIDEO_SUFFIX}, got {str(path)!r}")
-  if path.is_dir():
-    raise ValueError(f"cannot write video {str(path)!r}: it is a folder")
-  ancestor = path.absolute().parent
-  while not ancestor.exists():
-    ancestor = ancestor.parent
-  if not ancestor.is_dir():
-    raise ValueError(f"cannot write video {str(path)!r}: {str(ancestor)!r} is not a folder")
-  if not os.access(ancestor, os.W_OK | os.X_OK):
-    raise ValueError(f"cannot write video {str(path)!r}: no permission to write in "
-                     f"{str(ancestor)!r}")
-  if path.exists() and not os.access(path, os.W_OK):
-    raise ValueError(f"cannot write video {str(path)!r}: the file is read-only")
-  return path
+  return storage.check_writable(path, "video")

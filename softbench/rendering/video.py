@@ -34,6 +34,10 @@ class RenderingUnavailable(RuntimeError):
   """No OpenGL backend can render off-screen on this machine."""
 
 
+class RenderingFailed(RuntimeError):
+  """A backend that opened failed while rendering (its message in one line)."""
+
+
 @dataclasses.dataclass(frozen=True)
 class VideoStats:
   """What a render produced.
@@ -107,7 +111,7 @@ def _render_in_child(request: dict, backend: str, progress: Progress, bar) -> tu
   message = result.get("error") or _last_line(stderr)
   if not ready:
     return {"error": message}, False
-  raise RuntimeError(f"rendering with {backend} failed: {message}")
+  raise RenderingFailed(f"rendering with {backend} failed: {message}")
 
 
 def render(replay: episode_replay.Replay, output: str | os.PathLike,

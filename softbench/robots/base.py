@@ -16,6 +16,8 @@ import numpy as np
 from softbench.robots import faults as fault_model
 
 ACTION_MAP_NAME = "action_map"
+MODULE_LENGTH_RANGE = (0.005, 1.0)  # (m) Module lengths an arm accepts: a typo such as 80 for
+# 80 mm, or 1e-6, is refused rather than built (MuJoCo fails below about 1e-5 m).
 
 
 @dataclasses.dataclass(frozen=True)
@@ -180,3 +182,11 @@ class SoftArm(abc.ABC):
 def check_positive(name: str, value: float) -> None:
   if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
     raise ValueError(f"{name} must be a positive number, got {value!r}")
+
+
+def check_module_length(value: float) -> None:
+  """Raises a one-line ValueError unless ``value`` lies in ``MODULE_LENGTH_RANGE``."""
+  check_positive("module_length", value)
+  low, high = MODULE_LENGTH_RANGE
+  if not low <= value <= high:
+    raise ValueError(f"module_length must lie between {low:g} and {high:g} m, got {value!r}")

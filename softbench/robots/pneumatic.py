@@ -86,10 +86,11 @@ class PneumaticArm(base.SoftArm):
   faults: tuple[fault_model.Fault, ...] = ()
 
   def __post_init__(self):
-    for field in ("module_length", "bellows_offset", "bellows_radius", "bellows_stiffness",
+    for field in ("bellows_offset", "bellows_radius", "bellows_stiffness",
                   "module_mass", "backbone_radius", "backbone_bending_stiffness",
                   "backbone_axial_stiffness", "timestep", "control_period"):
       base.check_positive(field, getattr(self, field))
+    base.check_module_length(self.module_length)
     if not self.bellows_per_module or any(
         not isinstance(n, int) or n < 3 for n in self.bellows_per_module):
       raise ValueError(f"every module needs at least 3 bellows for omnidirectional bending, got "

@@ -98,9 +98,10 @@ class TendonArm(base.SoftArm):
                        f"got {self.segments_per_module!r}")
     if not 0 < self.hole_inset < 0.5:
       raise ValueError(f"hole_inset must lie strictly between 0 and 0.5, got {self.hole_inset!r}")
-    for field in ("module_length", "radius", "youngs_modulus", "density", "cable_offset",
+    for field in ("radius", "youngs_modulus", "density", "cable_offset",
                   "pass_through_offset", "max_tension", "timestep", "control_period"):
       base.check_positive(field, getattr(self, field))
+    base.check_module_length(self.module_length)
     for field in ("damping", "medium_viscosity", "armature"):
       if not getattr(self, field) >= 0:
         raise ValueError(f"{field} must be non-negative, got {getattr(self, field)!r}")

@@ -16,6 +16,8 @@ UNIT_TOLERANCE = 1e-3  # Largest accepted | |orientation vector| - 1 |.
 
 
 def _read(path: pathlib.Path) -> np.ndarray:
+  if path.is_dir():
+    raise ValueError(f"trajectory file {path} is a folder")
   if not path.is_file():
     raise ValueError(f"trajectory file {path} does not exist")
   try:
@@ -36,14 +38,14 @@ def load_trajectory(source, robot: base.SoftArm) -> np.ndarray:
       values or orientation vectors that are not unit length.
   """
   modules = robot.num_modules
-  expected = f"(steps, {6 * modules}): per row, each of the {modules} module(s)' tip position (m) " \
-             f"and unit orientation vector"
+  expected = (f"(steps, {6 * modules}): per row, each of the {modules} module(s)' tip position "
+              f"(m) and unit orientation vector")
   if isinstance(source, (str, pathlib.Path)):
     array = _read(pathlib.Path(source))
   else:
     array = np.asarray(source)
-  if not np.issubdtype(array.dtype, np.number):
-    raise ValueError(f"trajectory must be numeric, got dtype {array.dtype}")
+  if not np.issubdtype(array.dtype, np.number) or np.iscomplexobj(array):
+    raise ValueError(f"trajectory must hold real numbers, got dtype {array.dtype}")
   array = array.astype(float)
   if array.ndim == 3 and array.shape[1:] == (modules, 6):
     targets = array
