@@ -2,7 +2,7 @@
 
 A checkpoint holds the model's weights, the configuration dataclass it was built and trained with
 (stored as a dict), the normalisation statistics of its data (arrays, passed through untouched)
-and a sha256 of the weights and statistics (`softbench.storage.arrays_sha256`). Files are written
+and a sha256 of the weights and statistics (names, dtypes, shapes, bytes). Files are written
 atomically, so a crash never leaves a half-written checkpoint under the real name. Loading
 refuses, with a one-line `CheckpointError` naming the file, a file that is not a complete, intact
 checkpoint or whose configuration differs from the one expected, and leaves the model untouched.
@@ -13,6 +13,7 @@ Files written before the hash was added (no `sha256` field) load as before, unve
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import io
 import os
 import re
@@ -25,8 +26,6 @@ from typing import Any
 import numpy as np
 import torch
 from torch import nn
-
-from softbench import storage
 
 _FORMAT = "softbench-smpl-checkpoint"
 """Marks a file as one of ours."""
@@ -204,12 +203,13 @@ def _content_sha256(
     state_dict: Mapping[str, torch.Tensor], normalisation: Mapping[str, torch.Tensor]
 ) -> str:
     """The sha256 of the weights and normalisation arrays: names, dtypes, shapes and values."""
-    arrays = {
-        f"{group}/{name}": tensor.detach().cpu().numpy()
-        for group, tensors in (("state_dict", state_dict), ("normalisation", normalisation))
-        for name, tensor in tensors.items()
-    }
-    return storage.arrays_sha256(arrays)
+    digest = hashlib.sha256()
+    for group, tensors in (("state_dict", state_dict), ("normalisation", normalisation)):
+        for name in sorted(tensors):
+            array = np.ascontiguousarray(tensors[name].detach().cpu().numpy())
+            digest.update(f"{group}/{name}|{array.dtype.str}|{array.shape}|".encode())
+            digest.update(array.tobytes())
+    return digest.hexdigest()
 
 
 class _Missing:

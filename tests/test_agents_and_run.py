@@ -259,6 +259,78 @@ def test_run_refuses_bad_input_with_one_line(argv, message, capsys, tmp_path):
   assert not list(pathlib.Path(tmp_path).glob("*.json"))
 
 
+def _bad_trajectories(folder: pathlib.Path) -> dict[str, tuple[str, str]]:
+  """Trajectory files a user may give, each with the message it gets."""
+  (folder / "wrong-shape.csv").write_text("0.0,0.1,0.2\n")
+  (folder / "empty.csv").write_text("")
+  np.save(folder / "complex.npy", np.ones((3, 12), dtype=complex))
+  (folder / "a-folder.csv").mkdir()
+  return {"missing": ("nowhere.csv", "does not exist"),
+          "wrong shape": ("wrong-shape.csv", "must have shape (steps, 12)"),
+          "empty": ("empty.csv", "trajectory"),
+          "complex": ("complex.npy", "real numbers"),
+          "folder": ("a-folder.csv", "is a folder")}
+
+
+@pytest.mark.parametrize("case", ["missing", "wrong shape", "empty", "complex", "folder"])
+def test_a_bad_trajectory_is_refused_before_any_collection_or_training(case, capsys, tmp_path,
+                                                                         monkeypatch):
+  home = tmp_path / "home"
+  monkeypatch.setenv("SOFTBENCH_HOME", str(home))
+  name, message = _bad_trajectories(tmp_path)[case]
+  argv = ["run", "--task", "custom", "--agent", "lstm", "--robot", "tendon-2", "--profile",
+          "tiny", "--trajectory", str(tmp_path / name), "--results", str(tmp_path)]
+  assert cli.main(argv) == cli.EXIT_USAGE
+  lines = capsys.readouterr().err.strip().splitlines()
+  assert len(lines) == 1 and message in lines[0], lines
+  assert not home.exists()  # No dataset, no checkpoint, no reference.
+
+
+@pytest.mark.parametrize("flags", [["--width", "320"], ["--camera", "top"], ["--fps", "-1"],
+                                   ["--frames-per-step", "2", "--height", "240"]])
+@pytest.mark.parametrize("command", [["--task", "circle", "--agent", "zero"],
+                                     ["--protocol", "exp1s", "--agent", "smpl"]])
+def test_video_flags_without_a_video_are_refused(command, flags, capsys, tmp_path, monkeypatch):
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / "home"))
+  assert cli.main(["run", *command, *flags, "--results", str(tmp_path)]) == cli.EXIT_USAGE
+  lines = capsys.readouterr().err.strip().splitlines()
+  assert len(lines) == 1 and "go with --video" in lines[0] and flags[0] in lines[0]
+  assert not (tmp_path / "home").exists()
+
+
+@pytest.mark.parametrize("outputs,message", [
+    (["--results", "a-file"], "it is a file"),
+    (["--results", "a-file/records"], "is not a folder"),
+    (["--json", "a-folder"], "it is a folder"),
+    (["--json", "a-file/record.json"], "is not a folder"),
+])
+@pytest.mark.parametrize("command", [["run", "--task", "circle", "--agent", "lstm"],
+                                     ["run", "--protocol", "exp1s", "--agent", "smpl"],
+                                     ["retrain", "--fault", "2:0:0"]])
+def test_outputs_that_cannot_be_written_are_refused_before_the_run(command, outputs, message,
+                                                                     capsys, tmp_path,
+                                                                     monkeypatch):
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / "home"))
+  monkeypatch.chdir(tmp_path)
+  (tmp_path / "a-file").write_text("")
+  (tmp_path / "a-folder").mkdir()
+  assert cli.main([*command, "--profile", "tiny", *outputs]) == cli.EXIT_USAGE
+  lines = capsys.readouterr().err.strip().splitlines()
+  assert len(lines) == 1 and message in lines[0], lines
+  assert not (tmp_path / "home").exists()
+
+
+def test_a_data_home_that_cannot_be_used_is_one_line(capsys, tmp_path, monkeypatch):
+  (tmp_path / "a-file").write_text("")
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / "a-file"))
+  argv = ["collect", "--robot", "tendon-1", "--samples", "5", "--workers", "1"]
+  assert cli.main(argv) == cli.EXIT_FAILURE
+  err = capsys.readouterr().err
+  error_lines = [line for line in err.splitlines() if "error" in line.lower()]
+  assert "Traceback" not in err and len(error_lines) == 1, err
+  assert "a-file" in error_lines[0] and "Not a directory" in error_lines[0]
+
+
 @pytest.mark.parametrize("argv", [
     ["run", "--task", "circle", "--agent", "zero", "--seeds", "x"],
     ["run", "--task"],

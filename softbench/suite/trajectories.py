@@ -7,6 +7,7 @@ comments. An array may also be given as (steps, N, 6).
 """
 
 import pathlib
+import warnings
 
 import numpy as np
 
@@ -24,7 +25,9 @@ def _read(path: pathlib.Path) -> np.ndarray:
     if path.suffix == ".npy":
       return np.load(path, allow_pickle=False)
     if path.suffix == ".csv":
-      return np.loadtxt(path, delimiter=",", comments="#", ndmin=2)
+      with warnings.catch_warnings():  # An empty file: refused below, with the expected shape.
+        warnings.simplefilter("ignore", UserWarning)
+        return np.loadtxt(path, delimiter=",", comments="#", ndmin=2)
   except (OSError, ValueError, EOFError) as error:
     raise ValueError(f"trajectory file {path} is unreadable: {str(error).splitlines()[0]}")
   raise ValueError(f"trajectory file {path} must be .npy or .csv")
