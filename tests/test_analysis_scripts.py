@@ -51,3 +51,14 @@ def test_early_stopping_keeps_the_agent_softbench_run_trains(monkeypatch, capsys
   record = run.execute(run.settings("circle", "lstm", "tendon-1", seeds=1, profile="tiny"),
                        show_progress=False, workers=1)
   assert scores["best validation"] == f"{record['per_seed'][0]['position_mm']['mean']:.2f}"
+
+
+def test_validation_loss_reports_every_seed_of_every_agent(monkeypatch, capsys):
+  out = run_script("validation_loss", ["--agents", "mlp", "--robot", "tendon-1", "--profile",
+                                       "tiny", "--seeds", "2"], monkeypatch, capsys)
+  losses = re.findall(r"^mlp seed (\d): validation loss ([0-9.]+), test loss ([0-9.]+)$", out,
+                      re.MULTILINE)
+  assert [seed for seed, _, _ in losses] == ["0", "1"]
+  assert all(0 < float(validation) < 10 and 0 < float(test) < 10
+             for _, validation, test in losses)
+  assert losses[0][1:] != losses[1][1:]  # Each seed its own model.
