@@ -6,6 +6,8 @@ import os
 import pathlib
 import sys
 
+from dm_control.rl import control
+
 from softbench import adaptive
 from softbench import agents
 from softbench import continual
@@ -484,6 +486,10 @@ def main(argv: list[str] | None = None) -> int:
     return EXIT_USAGE
   except (run_module.WorkerDied, video.RenderingFailed) as error:
     print(f"softbench: error: {dataset.first_line(error)}", file=sys.stderr)
+    return EXIT_FAILURE
+  except control.PhysicsError as error:  # MuJoCo's state blew up during an episode.
+    print(f"softbench: error: the simulation became unstable ({dataset.first_line(error)})",
+          file=sys.stderr)
     return EXIT_FAILURE
   except KeyboardInterrupt:
     print("softbench: interrupted; run the same command again to resume", file=sys.stderr)

@@ -8,6 +8,7 @@ import warnings
 import numpy as np
 import pytest
 import torch
+from dm_control.rl import control
 
 from smpl import snapshots
 from smpl import training
@@ -362,3 +363,18 @@ def test_cli_lists_agents(capsys):
   assert cli.main(["agents"]) == 0
   out = capsys.readouterr().out
   assert all(f"\n{name} " in out for name in agents.AGENTS)
+
+
+def test_an_unstable_simulation_is_one_line(capsys, tmp_path, monkeypatch):
+  def blows_up(*args, **kwargs):
+    raise control.PhysicsError("Physics state is invalid. Warning(s) raised: mjWARN_BADQACC")
+
+  monkeypatch.setattr(evaluation, "run_episode", blows_up)
+  argv = ["run", "--task", "circle", "--agent", "zero", "--robot", "tendon-1", "--seeds", "1",
+          "--profile", "tiny", "--results", str(tmp_path)]
+  assert cli.main(argv) == cli.EXIT_FAILURE
+  err = capsys.readouterr().err
+  assert "Traceback" not in err
+  assert err.strip().splitlines()[-1] == ("softbench: error: the simulation became unstable "
+                                          "(Physics state is invalid. Warning(s) raised: "
+                                          "mjWARN_BADQACC)")
