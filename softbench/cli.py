@@ -506,7 +506,7 @@ def main(argv: list[str] | None = None) -> int:
 def _describe_os_error(error: OSError) -> str:
   """``error`` in one line: the file and the system's reason when it names them."""
   if error.filename is None or not error.strerror:
-    return str(error).splitlines()[0] if str(error) else type(error).__name__
+    return dataset.first_line(error)
   target = f" -> {error.filename2}" if error.filename2 is not None else ""
   return f"{error.filename}{target}: {error.strerror}"
 
