@@ -2,6 +2,7 @@
 
 import pytest
 
+from softbench import data
 from softbench import leaderboard
 
 
@@ -21,5 +22,17 @@ def assert_regenerates_identically():
     again = leaderboard.write(leaderboard.build(moved / "results"), moved / "results",
                               moved / "site")
     assert [path.read_bytes() for path in again] == contents
+
+  return check
+
+
+@pytest.fixture
+def assert_one_line_retraining():
+  """Checks that caught warnings hold one ``data.CorruptFileWarning``: one line naming the damaged
+  file and saying that it is trained again."""
+  def check(caught, path):
+    (warning,) = [entry for entry in caught if issubclass(entry.category, data.CorruptFileWarning)]
+    message = str(warning.message)
+    assert str(path) in message and "training it again" in message and "\n" not in message
 
   return check

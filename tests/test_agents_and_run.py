@@ -76,7 +76,8 @@ def test_training_from_scratch_is_deterministic(agent_name, tmp_path, monkeypatc
 
 
 @pytest.mark.parametrize("agent_name", LEARNED_AGENTS)
-def test_checkpoint_round_trip_gives_identical_actions(agent_name, tmp_path, monkeypatch):
+def test_checkpoint_round_trip_gives_identical_actions(agent_name, tmp_path, monkeypatch,
+                                                       assert_one_line_retraining):
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
   trained = episode(agent_name, "tendon-2", "circle")  # Trains, then saves the checkpoint.
   (checkpoint,) = (tmp_path / learned.CHECKPOINT_FOLDER).glob(f"{agent_name}-*.pt")
@@ -95,15 +96,9 @@ def test_checkpoint_round_trip_gives_identical_actions(agent_name, tmp_path, mon
   assert [path.name for path in checkpoint.parent.iterdir()] == [checkpoint.name]
 
 
-def assert_one_line_retraining(caught, path):
-  """``caught`` holds one warning: one line naming ``path`` and saying it is trained again."""
-  (warning,) = [entry for entry in caught if issubclass(entry.category, data.CorruptFileWarning)]
-  message = str(warning.message)
-  assert str(path) in message and "training it again" in message and "\n" not in message
-
-
 @pytest.mark.parametrize("damage", ["hello", "flipped weight"])
-def test_a_damaged_cached_forward_model_is_trained_again(damage, tmp_path, monkeypatch):
+def test_a_damaged_cached_forward_model_is_trained_again(damage, tmp_path, monkeypatch,
+                                                         assert_one_line_retraining):
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
   agents.make("mlp", "tendon-2", 0, "tiny")
   (forward,) = (tmp_path / forward_models.FOLDER).glob("*.pt")

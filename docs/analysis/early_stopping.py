@@ -13,7 +13,6 @@ Usage:
 import argparse
 import copy
 import dataclasses
-import importlib
 
 import torch
 
@@ -23,6 +22,7 @@ from softbench import robots
 from softbench import run
 from softbench.agents import hyperparameters
 from softbench.agents import learned
+from softbench.tuning import study
 from smpl import training
 
 
@@ -38,9 +38,7 @@ def main() -> None:
   args = parser.parse_args()
 
   arm, profile = robots.make(args.robot), profiles.get(args.profile)
-  agent_entry = agents.describe(args.agent)
-  learner = (importlib.import_module(agent_entry.module).LEARNER if agent_entry.learned
-             else None)
+  learner = study.learner(args.agent) if agents.describe(args.agent).learned else None
   if learner is None or learner.per_module:
     raise SystemExit(f"{args.agent} trains column by column; pick a centralised agent")
   (view,) = views = learner.views(arm)

@@ -1,4 +1,4 @@
-"""Each seed's validation and test loss for centralised learned agents, from their cached checkpoints.
+"""Each seed's validation and test loss of centralised learned agents, from cached checkpoints.
 
 The loss is the one early stopping reads: the closed-loop action MSE through the seed's frozen
 forward model, in normalised units, the VAE's KL term left out. Set beside the seeds' tracking
@@ -11,12 +11,12 @@ Usage:
 """
 
 import argparse
-import importlib
 
 from softbench import agents
 from softbench import profiles
 from softbench import robots
 from softbench.agents import learned
+from softbench.tuning import study
 from smpl import training
 
 
@@ -31,8 +31,7 @@ def main() -> None:
 
   arm, profile = robots.make(args.robot), profiles.get(args.profile)
   for name in args.agents:
-    entry = agents.describe(name)
-    learner = importlib.import_module(entry.module).LEARNER if entry.learned else None
+    learner = study.learner(name) if agents.describe(name).learned else None
     if learner is None or learner.per_module:
       raise SystemExit(f"{name} is not a centralised learned agent")
     views = learner.views(arm)

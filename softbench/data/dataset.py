@@ -39,6 +39,7 @@ import mujoco
 import numpy as np
 
 import softbench
+from smpl.checkpoint import first_line  # An exception's message on one line; used package-wide.
 from softbench import robots
 from softbench import storage
 from softbench.data import seeding
@@ -120,11 +121,6 @@ def check_count(name: str, value: int) -> None:
   """Raises a one-line ValueError unless ``value`` is an integer of at least 1."""
   if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1:
     raise ValueError(f"{name} must be a positive integer, got {value!r}")
-
-
-def first_line(error: BaseException) -> str:
-  """An exception's message on one line, for the one-line errors of this package."""
-  return (str(error).strip().splitlines() or [type(error).__name__])[0]
 
 
 def read_npz(content: bytes, error_type: type[ValueError]) -> dict[str, np.ndarray]:

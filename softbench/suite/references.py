@@ -145,8 +145,8 @@ def _load_cached(path, config: dict) -> Reference | None:
       raise ValueError("content does not match its hash")
   except (OSError, ValueError, TypeError, KeyError, EOFError, RecursionError,
           zipfile.BadZipFile) as error:
-    why = str(error).splitlines()[0] if str(error) else type(error).__name__
-    warnings.warn(f"{path}: unreadable cached reference ({why}); generating it again",
+    warnings.warn(f"{path}: unreadable cached reference ({dataset.first_line(error)}); "
+                  f"generating it again",
                   dataset.CorruptFileWarning, stacklevel=3)
     return None
   return Reference(config["shape"], arrays["actions"], arrays["poses"])
