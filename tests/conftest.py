@@ -1,5 +1,9 @@
 """Fixtures shared by the test files."""
 
+import os
+import subprocess
+import sys
+
 import pytest
 
 from softbench import data
@@ -36,3 +40,20 @@ def assert_one_line_retraining():
     assert str(path) in message and "training it again" in message and "\n" not in message
 
   return check
+
+
+# glvnd finds no EGL driver without its vendor files: EGL's library loads, its display does not.
+BROKEN_EGL_ENVIRONMENT = {"__EGL_VENDOR_LIBRARY_FILENAMES": "/nonexistent/egl_vendor.json"}
+
+
+@pytest.fixture
+def launch_with_broken_egl():
+  """Runs ``softbench ARGV`` in a child with MUJOCO_GL unset and an EGL that cannot open."""
+  def launch(argv: list[str]) -> subprocess.CompletedProcess:
+    inherited = {name: value for name, value in os.environ.items()
+                 if name not in ("MUJOCO_GL", "PYOPENGL_PLATFORM")}
+    return subprocess.run([sys.executable, "-m", "softbench.launcher", *argv],
+                          env={**inherited, **BROKEN_EGL_ENVIRONMENT}, capture_output=True,
+                          text=True, timeout=300)
+
+  return launch

@@ -9,6 +9,8 @@ import sys
 import mujoco
 import pytest
 
+import softbench
+from conftest import BROKEN_EGL_ENVIRONMENT
 from softbench import cli
 from softbench import robots
 from softbench import suite
@@ -125,6 +127,26 @@ def test_an_opengl_backend_mujoco_cannot_load_is_one_line(backend):
                           capture_output=True, text=True, timeout=120)
   assert result.returncode == cli.EXIT_USAGE
   assert result.stderr.count("\n") == 1 and f"MUJOCO_GL='{backend}'" in result.stderr
+
+
+def test_an_egl_that_cannot_open_falls_back_to_osmesa_or_says_what_to_install(
+    launch_with_broken_egl):
+  installed = softbench.installed_headless_backends()
+  if "egl" not in installed:
+    pytest.skip("EGL's library is not installed here, so softbench does not choose it")
+  probe = subprocess.run([sys.executable, "-c", "from dm_control import _render"],
+                         env={**os.environ, **BROKEN_EGL_ENVIRONMENT, "MUJOCO_GL": "egl"},
+                         capture_output=True, timeout=120)
+  if probe.returncode == 0:
+    pytest.skip("EGL opens here even without its vendor files")
+  result = launch_with_broken_egl(["robots"])
+  if "osmesa" in installed:  # softbench starts again with OSMesa.
+    assert result.returncode == 0, result.stderr
+    assert "tendon-3" in result.stdout and "Traceback" not in result.stderr
+  else:  # Nothing left to try: one line naming both the failure and what to install.
+    assert result.returncode == cli.EXIT_USAGE
+    assert result.stderr.count("\n") == 1 and result.stderr.startswith("softbench: error: ")
+    assert "MUJOCO_GL='egl'" in result.stderr and "libosmesa6" in result.stderr
 
 
 def test_a_closed_pipe_is_not_a_traceback(monkeypatch):

@@ -8,6 +8,7 @@ import mujoco
 import numpy as np
 import pytest
 
+import softbench
 from softbench import agents
 from softbench import cli
 from softbench import evaluation
@@ -189,6 +190,16 @@ def test_cli_render_writes_an_mp4_that_decodes(tmp_path, capsys):
   assert len(frames) == options.VideoOptions().frame_count(4) == 5  # Tiny profile: 4 steps.
   assert metadata["size"] == (64, 48) and metadata["fps"] == pytest.approx(10)
   assert [p.name for p in out.parent.iterdir()] == ["zero.mp4"]  # No temporary file left.
+
+
+@pytest.mark.skipif("osmesa" not in softbench.installed_headless_backends(),
+                    reason="OSMesa is not installed (Debian: libosmesa6)")
+def test_cli_render_falls_back_to_osmesa_when_egl_cannot_open(tmp_path, launch_with_broken_egl):
+  out = tmp_path / "zero.mp4"
+  result = launch_with_broken_egl([*RENDER, "--out", str(out)])
+  assert result.returncode == 0, result.stderr
+  assert "rendered with osmesa" in result.stdout
+  assert imageio_ffmpeg.count_frames_and_secs(str(out))[0] == 5
 
 
 @pytest.mark.parametrize("extra,message", [
