@@ -38,7 +38,8 @@ def main(argv: list[str] | None = None) -> int:
       environment = dict(os.environ, MUJOCO_GL=fallback,
                          **{FAILED_BACKENDS_VARIABLE: "; ".join(failures)})
       environment.pop("PYOPENGL_PLATFORM", None)  # dm_control sets it for the failed backend.
-      command = [sys.executable, "-m", "softbench.launcher", *(sys.argv[1:] if argv is None else argv)]
+      arguments = sys.argv[1:] if argv is None else argv
+      command = [sys.executable, "-m", "softbench.launcher", *arguments]
       os.execve(sys.executable, command, environment)
     print(f"softbench: error: MuJoCo cannot load an OpenGL backend ({'; '.join(failures)}); "
           f"unset MUJOCO_GL, or install what it needs ({INSTALL_HINT})", file=sys.stderr)
