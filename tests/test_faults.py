@@ -191,8 +191,8 @@ def test_cli_run_evaluates_under_the_fault(tmp_path, capsys):
   errors = {label: record["per_seed"][0]["position_mm"]["per_module"]
             for label, record in records.items()}
   assert errors["healthy"][1] != errors["cut"][1]
-  assert sorted(p.name.split("-fault")[1][:5] for p in (tmp_path / "results").glob("*fault*.json")) \
-      == ["2.0.0"]
+  fault_records = (tmp_path / "results").glob("*fault*.json")
+  assert sorted(path.name.split("-fault")[1][:5] for path in fault_records) == ["2.0.0"]
 
 
 def _state(module: torch.nn.Module) -> dict:
