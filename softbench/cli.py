@@ -484,7 +484,7 @@ def main(argv: list[str] | None = None) -> int:
   except (ValueError, FileNotFoundError, FloatingPointError, video.RenderingUnavailable) as error:
     print(f"softbench: error: {dataset.first_line(error)}", file=sys.stderr)
     return EXIT_USAGE
-  except (run_module.WorkerDied, video.RenderingFailed) as error:
+  except (run_module.WorkerDied, video.RenderingFailed, continual.ForgettingDetected) as error:
     print(f"softbench: error: {dataset.first_line(error)}", file=sys.stderr)
     return EXIT_FAILURE
   except control.PhysicsError as error:  # MuJoCo's state blew up during an episode.

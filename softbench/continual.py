@@ -133,14 +133,21 @@ def build(seed: int, profile: profiles.Profile, show_progress: bool = False) -> 
                     matrices["forgetting/action_mse"])
 
 
+class ForgettingDetected(RuntimeError):
+  """A frozen column's score changed after a later stage: a defect of softbench, not of the input."""
+
+
 def check_no_forgetting(matrix: np.ndarray) -> None:
-  """Raises if any configuration's score changed after a later stage (to the last bit)."""
+  """Raises ForgettingDetected if any configuration's score changed after a later stage (to the
+  last bit)."""
   for stage in range(1, len(matrix)):
     for configuration in range(stage):
       if matrix[stage, configuration] != matrix[configuration, configuration]:
-        raise RuntimeError(f"configuration {configuration + 1} changed after stage {stage + 1}: "
-                           f"{matrix[configuration, configuration]!r} -> "
-                           f"{matrix[stage, configuration]!r}")
+        raise ForgettingDetected(
+            f"configuration {configuration + 1} changed after stage {stage + 1}: "
+            f"{float(matrix[configuration, configuration])!r} -> "
+            f"{float(matrix[stage, configuration])!r}, "
+            f"though its column is frozen (a defect of softbench; please report it)")
 
 
 def _end_effector_scores(episode: evaluation.Episode, length: float) -> dict:

@@ -62,8 +62,23 @@ def test_forgetting_is_detected():
   matrix = np.array([[0.5, np.nan], [0.5, 0.2]])
   continual.check_no_forgetting(matrix)
   matrix[1, 0] = np.nextafter(0.5, 1.0)
-  with pytest.raises(RuntimeError, match="configuration 1 changed after stage 2"):
+  with pytest.raises(continual.ForgettingDetected, match="configuration 1 changed after stage 2"):
     continual.check_no_forgetting(matrix)
+
+
+def test_detected_forgetting_is_one_line_and_a_failure(monkeypatch, tmp_path, capsys):
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / "home"))
+  changed = np.array([[0.5, np.nan], [0.25, 0.2]])
+  monkeypatch.setattr(continual, "run_seed",
+                      lambda *arguments: continual.check_no_forgetting(changed))
+  argv = ["run", "--protocol", "exp1s", "--agent", "smpl", "--profile", "tiny", "--seeds", "1",
+          "--results", str(tmp_path / "results")]
+  assert cli.main(argv) == cli.EXIT_FAILURE
+  errors = capsys.readouterr().err
+  assert "Traceback" not in errors
+  error = errors.strip().splitlines()[-1]  # After the collection's progress bars.
+  assert error.startswith("softbench: error: configuration 1 changed after stage 2: 0.5 -> 0.25")
+  assert not (tmp_path / "results").exists()
 
 
 @pytest.mark.parametrize("extra,message", [
