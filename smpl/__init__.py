@@ -1,1 +1,2 @@
-"""SMPL: progressive LSTM networks, forward models and closed-loop training for modular soft arms."""
+"""SMPL: progressive LSTM networks, forward models and closed-loop training for modular soft
+arms."""

@@ -53,7 +53,8 @@ class Exp1sConfig:
   max_epochs: int
   patience: int
   compile: bool
-  params: tuple[tuple[str, object], ...]  # SMPL's hyperparameters (softbench.agents.hyperparameters)
+  # SMPL's hyperparameters (softbench.agents.hyperparameters).
+  params: tuple[tuple[str, object], ...]
   training_version: int = learned.TRAINING_VERSION
 
   @property
@@ -134,7 +135,8 @@ def build(seed: int, profile: profiles.Profile, show_progress: bool = False) -> 
 
 
 class ForgettingDetected(RuntimeError):
-  """A frozen column's score changed after a later stage: a defect of softbench, not of the input."""
+  """A frozen column's score changed after a later stage (a defect of softbench, not of the
+  input)."""
 
 
 def check_no_forgetting(matrix: np.ndarray) -> None:
@@ -198,7 +200,8 @@ def execute(profile: profiles.Profile, seeds: int | None = None, show_progress: 
   per_seed = run.over_seeds(run_seed, seeds, (profile,), f"smpl {PROTOCOL}", show_progress,
                             workers)
   return {"format": RECORD_FORMAT, "version": RECORD_VERSION, **origin,
-          "protocol": PROTOCOL, "agent": "smpl", "robots": list(protocols.get(PROTOCOL).robot_names),
+          "protocol": PROTOCOL, "agent": "smpl",
+          "robots": list(protocols.get(PROTOCOL).robot_names),
           "tasks": list(TASKS), "profile": profile.name,
           "profile_settings": dataclasses.asdict(profile), "seeds": seeds, "per_seed": per_seed,
           "wall_time_s": round(time.perf_counter() - started, 3)}

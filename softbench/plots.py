@@ -63,7 +63,8 @@ def tracking_paths(episode: evaluation.Episode, path: str | pathlib.Path, title:
   colours = _module_colours(robot, modules)
   columns = min(len(modules), MAX_PANEL_COLUMNS)
   rows = math.ceil(len(modules) / columns)
-  figure = Figure(figsize=(PANEL_INCHES * columns, PANEL_INCHES * rows * 0.8 + 0.4), layout="constrained")
+  figure = Figure(figsize=(PANEL_INCHES * columns, PANEL_INCHES * rows * 0.8 + 0.4),
+                  layout="constrained")
   errors = metrics.position_error_mm(episode.achieved[..., :3], episode.targets[..., :3])
   for index, module in enumerate(modules):
     axes = figure.add_subplot(rows, columns, index + 1, projection="3d")

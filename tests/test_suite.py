@@ -165,7 +165,8 @@ def test_reference_is_cached_and_a_corrupt_cache_is_regenerated(monkeypatch, tmp
   data = bytearray(npz.read_bytes())
   data[len(data) // 2] ^= 0xFF
   npz.write_bytes(bytes(data))
-  with pytest.warns(dataset.CorruptFileWarning, match=re.escape(f"{npz}: unreadable cached reference")):
+  unreadable = re.escape(f"{npz}: unreadable cached reference")
+  with pytest.warns(dataset.CorruptFileWarning, match=unreadable):
     regenerated = references.reference(arm, "circle", length=5)
   np.testing.assert_array_equal(regenerated.poses, first.poses)
   meta = json.loads(npz.with_suffix(".json").read_text())

@@ -176,6 +176,7 @@ def test_tune_refuses_bad_input_with_one_line(argv, message, capsys):
 
 def test_a_study_resumed_with_other_settings_is_refused(tmp_path, capsys):
   assert tune(tmp_path, "--study", "shared", trials=1) == 0
+  capsys.readouterr()  # The first study's output (with the collection's bar, run alone).
   assert tune(tmp_path, "--study", "shared", agent="lstm", trials=1) == cli.EXIT_USAGE
   lines = capsys.readouterr().err.strip().splitlines()
   assert len(lines) == 1 and "was made with other settings (agent" in lines[0]

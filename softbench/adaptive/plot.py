@@ -78,7 +78,8 @@ def figure(record: dict) -> Figure:
   for index, path in enumerate(paths):
     _path_panel(fig.add_subplot(grid[1, index], projection="3d"), path, colours)
   if paths:
-    fig.legend(handles=_path_legend(labels, colours), loc="outside lower center", ncols=4, fontsize=8)
+    fig.legend(handles=_path_legend(labels, colours), loc="outside lower center", ncols=4,
+               fontsize=8)
   return fig
 
 

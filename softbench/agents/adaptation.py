@@ -174,7 +174,8 @@ def _retrain(agent: learned.LearnedAgent, inverse: progressive.ProgressiveLSTM,
   label = f"{dataset.robot_name} seed {seed}"
   for index in range(module - 1, len(forwards)):
     forwards[index].requires_grad_(True)
-    with learned.progress_bar(f"forward module-{index + 1} {label}", profile.max_epochs, show) as bar:
+    bar_label = f"forward module-{index + 1} {label}"
+    with learned.progress_bar(bar_label, profile.max_epochs, show) as bar:
       training.train_forward_model(forwards[index], windows[index].train,
                                    windows[index].validation, forward_config, device, bar)
   inverse.requires_grad_(False)

@@ -1,5 +1,5 @@
-"""The bilstm baseline: a bidirectional LSTM over the last 15 inputs, one centralised model for the whole arm, trained in the
-same closed loop as SMPL."""
+"""The bilstm baseline: a bidirectional LSTM over the last 15 inputs, one centralised model for
+the whole arm, trained in the same closed loop as SMPL."""
 
 from smpl import baselines
 from softbench.agents import learned

@@ -1,5 +1,5 @@
-"""The vae-lstm baseline: a variational LSTM, one centralised model for the whole arm, trained in the
-same closed loop as SMPL."""
+"""The vae-lstm baseline: a variational LSTM, one centralised model for the whole arm, trained
+in the same closed loop as SMPL."""
 
 from smpl import baselines
 from softbench.agents import learned

@@ -24,7 +24,8 @@ def check_module(robot: robot_base.SoftArm, module: int | None) -> int:
     ValueError: ``module`` is not one of the robot's modules (one line).
   """
   module = min(DEFAULT_MODULE, robot.num_modules) if module is None else module
-  if isinstance(module, bool) or not isinstance(module, int) or not 1 <= module <= robot.num_modules:
+  is_index = isinstance(module, int) and not isinstance(module, bool)
+  if not is_index or not 1 <= module <= robot.num_modules:
     raise ValueError(f"module must be 1 to {robot.num_modules} for {robot.name}, got {module!r}")
   return module
 

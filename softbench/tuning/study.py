@@ -104,8 +104,9 @@ def settings(agent: str, robot: str, trials: int = DEFAULT_TRIALS, storage_url: 
       opened (one line).
   """
   if not agents.describe(agent).learned:
+    learners = ", ".join(name for name in agents.AGENTS if agents.describe(name).learned)
     raise ValueError(f"agent {agent!r} does not learn, so it has nothing to tune; choose one of "
-                     f"{', '.join(name for name in agents.AGENTS if agents.describe(name).learned)}")
+                     f"{learners}")
   robots.make(robot)
   chosen_profile = profiles.get(profile)
   if isinstance(trials, bool) or not isinstance(trials, int) or trials < 1:
