@@ -42,18 +42,21 @@ def assert_one_line_retraining():
   return check
 
 
-# glvnd finds no EGL driver without its vendor files: EGL's library loads, its display does not.
-BROKEN_EGL_ENVIRONMENT = {"__EGL_VENDOR_LIBRARY_FILENAMES": "/nonexistent/egl_vendor.json"}
+@pytest.fixture
+def broken_egl_environment():
+  """Environment variables under which EGL's library loads but no display opens: glvnd finds no
+  EGL driver without its vendor files."""
+  return {"__EGL_VENDOR_LIBRARY_FILENAMES": "/nonexistent/egl_vendor.json"}
 
 
 @pytest.fixture
-def launch_with_broken_egl():
+def launch_with_broken_egl(broken_egl_environment):
   """Runs ``softbench ARGV`` in a child with MUJOCO_GL unset and an EGL that cannot open."""
   def launch(argv: list[str]) -> subprocess.CompletedProcess:
     inherited = {name: value for name, value in os.environ.items()
                  if name not in ("MUJOCO_GL", "PYOPENGL_PLATFORM")}
     return subprocess.run([sys.executable, "-m", "softbench.launcher", *argv],
-                          env={**inherited, **BROKEN_EGL_ENVIRONMENT}, capture_output=True,
+                          env={**inherited, **broken_egl_environment}, capture_output=True,
                           text=True, timeout=300)
 
   return launch

@@ -10,7 +10,6 @@ import mujoco
 import pytest
 
 import softbench
-from conftest import BROKEN_EGL_ENVIRONMENT
 from softbench import cli
 from softbench import robots
 from softbench import suite
@@ -130,12 +129,12 @@ def test_an_opengl_backend_mujoco_cannot_load_is_one_line(backend):
 
 
 def test_an_egl_that_cannot_open_falls_back_to_osmesa_or_says_what_to_install(
-    launch_with_broken_egl):
+    broken_egl_environment, launch_with_broken_egl):
   installed = softbench.installed_headless_backends()
   if "egl" not in installed:
     pytest.skip("EGL's library is not installed here, so softbench does not choose it")
   probe = subprocess.run([sys.executable, "-c", "from dm_control import _render"],
-                         env={**os.environ, **BROKEN_EGL_ENVIRONMENT, "MUJOCO_GL": "egl"},
+                         env={**os.environ, **broken_egl_environment, "MUJOCO_GL": "egl"},
                          capture_output=True, timeout=120)
   if probe.returncode == 0:
     pytest.skip("EGL opens here even without its vendor files")
