@@ -23,7 +23,8 @@ REACH_STEPS = 3
 CIRCLE_LENGTH = 100  # Targets of the circle, of which the tests follow the first ...
 TRACKING_STEPS = 10  # ... ones.
 BABBLING_LENGTH = 10  # Held-out babbling targets, of which the tests follow the first ...
-BABBLING_STEPS = 3  # ... ones.
+BABBLING_STEPS = 3  # ... ones (the restart-memory test) ...
+BABBLING_SCORED_STEPS = 10  # ... or more (the tracking test; see its comment).
 FULL_STATE = mujoco.mjtState.mjSTATE_INTEGRATION  # Physics, controls and applied forces.
 
 Episode = collections.namedtuple("Episode", ["actions", "achieved", "targets", "untouched"])
@@ -144,10 +145,12 @@ def test_reference_agent_forgets_its_restart_memory_between_episodes():
     # Measured (mean normalised tip error, zero agent -> reference agent): tendon-2 circle
     # 21.2 % -> 0.0003 %, pneumatic-433 circle 15.6 % -> 0.012 %, tendon-3 reach (module 2)
     # 29.3 % -> 0.002 %. Babbling targets jump across the workspace every step: tendon-3, first
-    # 3 steps, needs the restart from sampled actions (without it 16.6 %, against the zero agent's
-    # 57.3 %; with it 0.0005 %).
+    # 10 steps, needs the restart from sampled actions (without it 28.4 %, against the zero
+    # agent's 50.6 %; with it 2.3 %). Scoring fewer steps rests on single steps: on one machine
+    # (AVX-512) the first restart, at step 3, stalls 9 to 46 mm off, which took the first 3 steps'
+    # mean from 0.0005 % (measured elsewhere) to 6.8 %.
     ("tendon-2", "circle", {"length": CIRCLE_LENGTH, "max_steps": TRACKING_STEPS}),
-    ("tendon-3", "babbling", {"length": BABBLING_LENGTH, "max_steps": BABBLING_STEPS}),
+    ("tendon-3", "babbling", {"length": BABBLING_LENGTH, "max_steps": BABBLING_SCORED_STEPS}),
     ("pneumatic-433", "circle", {"length": CIRCLE_LENGTH, "max_steps": TRACKING_STEPS}),
     ("tendon-3", "reach", {"steps": REACH_STEPS}),
 ])
