@@ -31,6 +31,16 @@ def test_results_come_back_in_order():
   assert run._parallel(square, [(3,), (1,), (2,)], "squares", workers=2) == [9, 1, 4]
 
 
+def torch_threads(_):
+  import torch  # pylint: disable=import-outside-toplevel
+  return torch.get_num_threads()
+
+
+def test_every_worker_runs_one_torch_thread():
+  # Torch's default is one thread per core in every worker, which oversubscribes the cores.
+  assert run._parallel(torch_threads, [(0,), (1,)], "threads", workers=2) == [1, 1]
+
+
 def test_a_worker_error_is_raised():
   with pytest.raises(ValueError, match="bad seed"):
     run._parallel(fail, [(1,), (2,)], "failing", workers=2)
