@@ -255,7 +255,7 @@ def _init_worker() -> None:
   per core in every worker, made a BiLSTM's evaluation step 450 times slower, 930 ms against 2 ms,
   with the cores busy); Ctrl-C reaches the parent only, which stops the workers itself; warnings
   print as in the parent."""
-  torch.set_num_threads(1)
+  torch.set_num_threads(learned.training.CPU_THREADS)
   signal.signal(signal.SIGINT, signal.SIG_IGN)
   one_line_warnings()
 
@@ -310,12 +310,14 @@ def _terminate(executor: futures.ProcessPoolExecutor) -> None:
 
 def over_seeds(function, seeds: int, arguments: tuple, label: str, show_progress: bool,
                 workers: int | None) -> list:
-  """``function(seed, *arguments, show)`` for seeds 0..seeds-1, in parallel on every core."""
+  """``function(seed, *arguments, show)`` for seeds 0..seeds-1, in parallel on every core; each
+  seed computes with ``smpl.training.CPU_THREADS`` torch threads, in this process or a worker."""
   workers = min(seeds, workers or os.cpu_count() or 1)
   if workers > 1:
     return _parallel(function, [(seed, *arguments, False) for seed in range(seeds)],
                      f"{label}: seeds", workers)
-  return [function(seed, *arguments, show_progress) for seed in range(seeds)]
+  with learned.training.limited_cpu_threads(learned.training.CPU_THREADS, torch.device("cpu")):
+    return [function(seed, *arguments, show_progress) for seed in range(seeds)]
 
 
 def provenance() -> dict:

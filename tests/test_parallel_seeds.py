@@ -9,6 +9,7 @@ import sys
 import time
 
 import pytest
+import torch
 
 from softbench import run
 
@@ -32,13 +33,20 @@ def test_results_come_back_in_order():
 
 
 def torch_threads(_):
-  import torch  # pylint: disable=import-outside-toplevel
   return torch.get_num_threads()
 
 
-def test_every_worker_runs_one_torch_thread():
+def test_every_seed_runs_one_torch_thread():
   # Torch's default is one thread per core in every worker, which oversubscribes the cores.
   assert run._parallel(torch_threads, [(0,), (1,)], "threads", workers=2) == [1, 1]
+  before = torch.get_num_threads()
+  torch.set_num_threads(2)
+  try:  # In this process (one worker), for the seeds only.
+    assert run.over_seeds(lambda seed, show: torch_threads(seed), 2, (), "threads", False,
+                          workers=1) == [1, 1]
+    assert torch.get_num_threads() == 2
+  finally:
+    torch.set_num_threads(before)
 
 
 def test_a_worker_error_is_raised():
