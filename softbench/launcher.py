@@ -31,8 +31,8 @@ def main(argv: list[str] | None = None) -> int:
   except (ImportError, AttributeError, RuntimeError, OSError) as error:
     backend = os.environ.get("MUJOCO_GL")
     failures = [entry for entry in [os.environ.get(FAILED_BACKENDS_VARIABLE)] if entry]
-    message = (str(error).strip().splitlines() or ["no message"])[0]
-    failures.append(f"MUJOCO_GL={backend!r}: {type(error).__name__}: {message}")
+    from smpl.checkpoint import first_line  # pylint: disable=import-outside-toplevel
+    failures.append(f"MUJOCO_GL={backend!r}: {type(error).__name__}: {first_line(error)}")
     fallback = _fallback(backend) if softbench.AUTOMATIC_GL_BACKEND == backend else None
     if fallback is not None:
       environment = dict(os.environ, MUJOCO_GL=fallback,
