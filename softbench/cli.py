@@ -157,7 +157,7 @@ def _run_protocol(args: argparse.Namespace) -> None:
   if given or args.eval != "physics":
     raise ValueError(f"--protocol {args.protocol} fixes its robots, tasks and loops; drop "
                      f"{', '.join(given) or '--eval'}")
-  record = continual.execute(profiles.get(args.profile), args.seeds)
+  record = continual.execute(profiles.get(args.profile), args.seeds, workers=args.workers)
   print(continual.table(record))
   path = continual.record_path(record, pathlib.Path(args.results))
   run_module.write_record(record, path)
@@ -211,6 +211,8 @@ def _run(args: argparse.Namespace) -> None:
   if args.video is None and _video_flags_given(args):
     raise ValueError(f"{', '.join(_video_flags_given(args))} go with --video FILE.mp4")
   _check_record_arguments(args)
+  if args.workers is not None:  # Before any collection or training starts.
+    dataset.check_count("workers", args.workers)
   if args.protocol is not None:
     return _run_protocol(args)
   if args.task is None:
@@ -223,7 +225,7 @@ def _run(args: argparse.Namespace) -> None:
   if args.video:
     options = _video_options(args)
     video_path = video_options.check_video_path(args.video)
-  record, episodes = run_module.execute_episodes(settings, keep_seeds=True)
+  record, episodes = run_module.execute_episodes(settings, keep_seeds=True, workers=args.workers)
   print(run_module.table(record))
   path = run_module.record_path(record, pathlib.Path(args.results))
   run_module.write_record(record, path)
@@ -394,6 +396,10 @@ def build_parser() -> argparse.ArgumentParser:
   run_parser.add_argument("--robot", help="default: the task's robot in the paper (tendon-3; "
                                           "pneumatic-433 for reach)")
   run_parser.add_argument("--seeds", type=int, help="number of seeds (default: the profile's)")
+  run_parser.add_argument("--workers", type=int,
+                          help="processes that run seeds in parallel (default: one per core, at "
+                               "most one per seed); more than the cores keeps them all busy "
+                               "while the last seeds run, e.g. 3 for 5 seeds on 2 cores")
   _add_profile_argument(run_parser)
   _add_eval_argument(run_parser)
   run_parser.add_argument("--trajectory", help="target poses for --task custom (.npy or .csv)")

@@ -310,8 +310,11 @@ def _terminate(executor: futures.ProcessPoolExecutor) -> None:
 
 def over_seeds(function, seeds: int, arguments: tuple, label: str, show_progress: bool,
                 workers: int | None) -> list:
-  """``function(seed, *arguments, show)`` for seeds 0..seeds-1, in parallel on every core; each
-  seed computes with ``smpl.training.CPU_THREADS`` torch threads, in this process or a worker."""
+  """``function(seed, *arguments, show)`` for seeds 0..seeds-1, in ``workers`` processes (default:
+  one per core), never more than there are seeds; each seed computes with
+  ``smpl.training.CPU_THREADS`` torch threads, in this process or a worker."""
+  if workers is not None:
+    dataset.check_count("workers", workers)
   workers = min(seeds, workers or os.cpu_count() or 1)
   if workers > 1:
     return _parallel(function, [(seed, *arguments, False) for seed in range(seeds)],

@@ -237,11 +237,36 @@ def test_softbench_run_end_to_end(tmp_path, capsys):
   assert f"{mean.mean:.2f}" in mean_row
 
 
+def test_the_worker_count_changes_no_result(tmp_path, monkeypatch):
+  asked = []
+
+  def over_seeds(*args):
+    asked.append(args[-1])  # The worker count.
+    return over_all_seeds(*args)
+
+  over_all_seeds = run.over_seeds
+  monkeypatch.setattr(run, "over_seeds", over_seeds)
+  records = []
+  for workers in ("1", "3"):  # 3 workers for 2 seeds: 2 processes.
+    path = tmp_path / f"workers{workers}.json"
+    argv = ["run", "--task", "circle", "--agent", "random", "--robot", "tendon-1", "--profile",
+            "tiny", "--workers", workers, "--results", str(tmp_path / workers), "--json",
+            str(path)]
+    assert cli.main(argv) == 0
+    records.append(json.loads(path.read_text()))
+  assert asked == [1, 3]
+  assert [entry["seed"] for entry in records[0]["per_seed"]] == [0, 1]
+  assert records[0]["per_seed"] == records[1]["per_seed"]
+  assert records[0]["per_seed"][0] != records[0]["per_seed"][1]
+
+
 @pytest.mark.parametrize("argv,message", [
     (["--task", "juggle", "--agent", "smpl"], "unknown task"),
     (["--task", "circle", "--agent", "oracle"], "unknown agent"),
     (["--task", "circle", "--agent", "zero", "--robot", "tendon-0"], "1 to 10 modules"),
     (["--task", "circle", "--agent", "zero", "--seeds", "0"], "seeds must be"),
+    (["--task", "circle", "--agent", "zero", "--workers", "0"], "workers must be"),
+    (["--protocol", "exp1s", "--agent", "smpl", "--workers", "-1"], "workers must be"),
     (["--task", "circle", "--agent", "zero", "--profile", "huge"], "unknown profile"),
     (["--task", "circle", "--agent", "zero", "--eval", "dream"], "unknown eval mode"),
     (["--task", "custom", "--agent", "zero"], "--trajectory"),
