@@ -7,6 +7,11 @@ in well under a minute; the properties do not depend on the length.
 
 import collections
 import functools
+import os
+import pathlib
+import platform
+import subprocess
+import sys
 
 import mujoco
 import numpy as np
@@ -147,8 +152,8 @@ def test_reference_agent_forgets_its_restart_memory_between_episodes():
     # 29.3 % -> 0.002 %. Babbling targets jump across the workspace every step: tendon-3, first
     # 10 steps, needs the restart from sampled actions (without it 28.4 %, against the zero
     # agent's 50.6 %; with it 2.3 %). Scoring fewer steps rests on single steps: on one machine
-    # (AVX-512) the first restart, at step 3, stalls 9 to 46 mm off, which took the first 3 steps'
-    # mean from 0.0005 % (measured elsewhere) to 6.8 %.
+    # the first restart, at step 3, stalls or converges depending on last bits (see the test of
+    # OpenBLAS's kernels below).
     ("tendon-2", "circle", {"length": CIRCLE_LENGTH, "max_steps": TRACKING_STEPS}),
     ("tendon-3", "babbling", {"length": BABBLING_LENGTH, "max_steps": BABBLING_SCORED_STEPS}),
     ("pneumatic-433", "circle", {"length": CIRCLE_LENGTH, "max_steps": TRACKING_STEPS}),
@@ -158,3 +163,38 @@ def test_reference_agent_tracks_far_better_than_zero(robot, task, options):
   reference = tip_error_percent("reference", robot, task, **options)
   zero = tip_error_percent("zero", robot, task, **options)
   assert reference < zero / 10, (reference, zero)
+
+
+_BABBLING_ACTIONS_PROGRAM = """
+import sys
+import numpy as np
+import test_agents_model_based as tests
+from softbench import agents, suite
+env = suite.load("tendon-3", "babbling", seed=0, length=tests.BABBLING_LENGTH)
+episode = tests.run_episode(agents.make("reference", "tendon-3"), env, "babbling",
+                            tests.BABBLING_STEPS)
+np.save(sys.argv[1], episode.actions)
+"""
+
+
+@pytest.mark.skipif(platform.machine().lower() not in ("x86_64", "amd64"),
+                    reason="OpenBLAS's x86-64 kernels")
+def test_reference_actions_do_not_depend_on_the_cpus_blas_kernels(tmp_path):
+  # numpy's OpenBLAS picks its kernels by CPU; with numpy's algebra, the first babbling restart
+  # (step 3) stalled 9 to 46 mm off with the AVX-512 kernels, 6 to 31 mm with the SSE ones and
+  # converged with the AVX2 ones, and step 1's actions already differed by 2e-15.
+  actions = {}
+  for kernel in ("Nehalem", None):  # SSE4.2, which every x86-64 CPU of the last 15 years has;
+    # then the machine's own (the same on an SSE-only CPU, which makes the test vacuous there).
+    environment = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
+    environment.pop("OPENBLAS_CORETYPE", None)
+    if kernel:
+      environment["OPENBLAS_CORETYPE"] = kernel
+    path = tmp_path / f"{kernel}.npy"
+    subprocess.run([sys.executable, "-c", _BABBLING_ACTIONS_PROGRAM, str(path)], check=True,
+                   env={**environment, "PYTHONPATH": os.pathsep.join(
+                       [str(pathlib.Path(__file__).parent), environment.get("PYTHONPATH", "")])},
+                   timeout=300)
+    actions[kernel] = np.load(path)
+  assert actions["Nehalem"].shape == (BABBLING_STEPS, robots.make("tendon-3").action_dim)
+  np.testing.assert_array_equal(actions["Nehalem"], actions[None])

@@ -30,8 +30,9 @@ held for one control period, brings the scored modules' tips to this step's targ
 The constants were chosen by measurement on tendon-3 reach (8 seeds), tendon-2 circle
 (10 steps), pneumatic-433 circle and spiral and tendon-3 spiral (first 60-100 steps), and the
 restart's on babbling. Every simulation starts from the same copied state, so the same state and
-observation always give the same action, whatever the thread count; the memory starts empty at
-every ``reset``. Near the arms' bending limits the pose can depend roughly on the action; there
+observation always give the same action, whatever the thread count, and whatever kernels
+OpenBLAS picks for the CPU (the algebra is MuJoCo's, see ``_damped_least_squares``); the memory
+starts empty at every ``reset``. Near the arms' bending limits the pose can depend roughly on the action; there
 the agent may stop a few mm from a reach target.
 
 Cost on a 2-core CPU: about 0.1 s per control step of tendon-3 (a 1000-step tracking episode in
@@ -144,14 +145,13 @@ class ReferenceAgent(base.Agent):
             action: np.ndarray) -> np.ndarray:
     """The next action: argmin |J d - r|^2 + damping^2 |d|^2 + effort^2 |a + d|^2 over the
     entries not pressed against a bound, shortened to ``MAX_STEP`` and clipped to [-1, 1]."""
-    effort = EFFORT * min(1.0, np.linalg.norm(residual) / EFFORT_SCALE)
+    effort = EFFORT * min(1.0, mujoco.mju_norm(residual) / EFFORT_SCALE)
     free = np.ones(len(action), dtype=bool)
     step = np.zeros(len(action))
     for _ in range(len(action)):
-      columns = jacobian[:, free]
-      normal = columns.T @ columns + (damping**2 + effort**2) * np.eye(columns.shape[1])
       step[:] = 0.0
-      step[free] = np.linalg.solve(normal, columns.T @ residual - effort**2 * action[free])
+      step[free] = _damped_least_squares(jacobian[:, free], residual, damping**2 + effort**2,
+                                         effort**2 * action[free])
       pressed = free & (((action >= 1.0) & (step > 0)) | ((action <= -1.0) & (step < 0)))
       if not pressed.any() or pressed.all():
         break
@@ -204,14 +204,16 @@ class ReferenceAgent(base.Agent):
     residual = goal - feature
     damping = DAMPING
     for _ in range(iterations):
-      if np.linalg.norm(residual) < TOLERANCE:
+      if mujoco.mju_norm(residual) < TOLERANCE:
         break
       candidate = self._step(jacobian, residual, damping, action)
       candidate_feature = self._simulate(candidate[None], orientation)[0]
-      if np.linalg.norm(goal - candidate_feature) < np.linalg.norm(residual):
+      if mujoco.mju_norm(goal - candidate_feature) < mujoco.mju_norm(residual):
         step = candidate - action
-        jacobian = jacobian + np.outer(candidate_feature - feature - jacobian @ step,
-                                       step) / (step @ step)
+        predicted_change = np.empty(len(feature))
+        mujoco.mju_mulMatVec(predicted_change, jacobian, step)
+        jacobian = jacobian + np.outer(candidate_feature - feature - predicted_change,
+                                       step) / mujoco.mju_dot(step, step)
         action, feature, residual = candidate, candidate_feature, goal - candidate_feature
         fresh = False
       elif not fresh:
@@ -219,7 +221,29 @@ class ReferenceAgent(base.Agent):
         fresh = True
       else:
         damping *= DAMPING_GROWTH
-    return action, float(np.linalg.norm(residual))
+    return action, mujoco.mju_norm(residual)
+
+
+def _damped_least_squares(jacobian: np.ndarray, residual: np.ndarray, regulariser: float,
+                          pull: np.ndarray) -> np.ndarray:
+  """The step d solving (J^T J + regulariser I) d = J^T residual - pull, by Cholesky.
+
+  MuJoCo's own routines, not numpy's: numpy's products and solves run through OpenBLAS, which picks
+  its kernels by CPU, and their last-bit differences decide some of babbling's restarts (the same
+  tendon-3 step stalled 9 to 46 mm off with the AVX-512 kernels, 6 to 31 mm off with the SSE ones
+  and converged with the AVX2 ones). MuJoCo's are the same code on every CPU, as the physics is.
+  """
+  size = jacobian.shape[1]
+  normal = np.empty((size, size))
+  mujoco.mju_mulMatTMat(normal, jacobian, jacobian)
+  normal[np.diag_indices(size)] += regulariser
+  right_hand_side = np.empty(size)
+  mujoco.mju_mulMatTVec(right_hand_side, jacobian, residual)
+  right_hand_side -= pull
+  mujoco.mju_cholFactor(normal, 0.0)
+  step = np.empty(size)
+  mujoco.mju_cholSolve(step, normal, right_hand_side)
+  return step
 
 
 def build(robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
