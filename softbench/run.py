@@ -170,9 +170,25 @@ def _git_commit() -> str | None:
 
 
 def _machine() -> dict:
-  return {"platform": platform.platform(), "processor": platform.processor() or
-          platform.machine(), "cpu_count": os.cpu_count(), "python": platform.python_version(),
+  return {"platform": platform.platform(), "processor": _processor(),
+          "cpu_count": os.cpu_count(), "python": platform.python_version(),
           "torch": torch.__version__, "device": str(learned.training.default_device())}
+
+
+def _processor() -> str:
+  """The CPU's model name where Linux tells it (``platform.processor()`` is empty there), else
+  what ``platform`` knows; with ``avx512``/``avx2`` added where Linux lists those flags, since
+  libraries that pick kernels by CPU (OpenBLAS, oneDNN) round differently with them."""
+  try:
+    cpuinfo = pathlib.Path("/proc/cpuinfo").read_text()
+  except OSError:
+    return platform.processor() or platform.machine()
+  fields = dict(line.split(":", 1) for line in cpuinfo.splitlines() if ":" in line)
+  fields = {key.strip(): value.strip() for key, value in fields.items()}
+  name = fields.get("model name") or platform.processor() or platform.machine()
+  flags = fields.get("flags", "").split()
+  widest = next((kind for kind in ("avx512f", "avx2") if kind in flags), None)
+  return f"{name} ({widest.removesuffix('f')})" if widest else name
 
 
 def episode_on(agent: agents.Agent, arm: robots.SoftArm, run: RunSettings, seed: int,

@@ -232,6 +232,7 @@ def test_softbench_run_end_to_end(tmp_path, capsys):
   assert all(len(entry["position_mm"]["per_module"]) == 2 for entry in record["per_seed"])
   for field in ("softbench_version", "git_commit", "date", "machine", "wall_time_s"):
     assert field in record
+  assert record["machine"]["processor"].strip()
   per_module, mean = run.summary(record, "position_mm")
   mean_row = next(line for line in out.splitlines() if line.startswith("mean "))
   assert f"{mean.mean:.2f}" in mean_row
