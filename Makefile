@@ -30,6 +30,7 @@ models: $(STAMP)
 # resumes from the cached datasets, checkpoints, training snapshots and finished seeds, so an
 # interrupted fill goes on where it stopped; the pages show the newest record of each setting.
 PROFILE ?= paper
+WORKERS ?=# Processes per run (softbench run --workers); empty: one per core.
 RESULTS := leaderboard/results
 LEADERBOARD_ROBOTS := tendon-3 pneumatic-433
 LEADERBOARD_TASKS := babbling circle rectangle spiral reach
@@ -40,10 +41,10 @@ leaderboard: $(STAMP)
 	    if ls $(RESULTS)/$$agent-$$robot-$$task-$(PROFILE)-physics-*.json >/dev/null 2>&1; then \
 	      echo "skipped $$agent on $$robot $$task: it has a $(PROFILE) record"; continue; fi; \
 	    $(VENV)/bin/softbench run --robot $$robot --task $$task --agent $$agent --profile $(PROFILE) \
-	      --results $(RESULTS); \
+	      $(if $(WORKERS),--workers $(WORKERS)) --results $(RESULTS); \
 	  done; done; done
 	if ls $(RESULTS)/smpl-exp1s-$(PROFILE)-*.json >/dev/null 2>&1; then \
 	  echo "skipped exp1s: it has a $(PROFILE) record"; \
 	else $(VENV)/bin/softbench run --protocol exp1s --agent smpl --profile $(PROFILE) \
-	  --results $(RESULTS); fi
+	  $(if $(WORKERS),--workers $(WORKERS)) --results $(RESULTS); fi
 	$(VENV)/bin/softbench leaderboard --results $(RESULTS) --write
