@@ -32,8 +32,8 @@ The constants were chosen by measurement on tendon-3 reach (8 seeds), tendon-2 c
 restart's on babbling. Every simulation starts from the same copied state, so the same state and
 observation always give the same action, whatever the thread count, and whatever kernels
 OpenBLAS picks for the CPU (the algebra is MuJoCo's, see ``_damped_least_squares``); the memory
-starts empty at every ``reset``. Near the arms' bending limits the pose can depend roughly on the action; there
-the agent may stop a few mm from a reach target.
+starts empty at every ``reset``. Near the arms' bending limits the pose can depend roughly on the
+action; there the agent may stop a few mm from a reach target.
 
 Cost on a 2-core CPU: about 0.1 s per control step of tendon-3 (a 1000-step tracking episode in
 about 2 minutes), 0.05 s on pneumatic-433; a control period of tendon-5 is 3x dearer to simulate.
