@@ -157,11 +157,14 @@ def _run_protocol(args: argparse.Namespace) -> None:
   if given or args.eval != "physics":
     raise ValueError(f"--protocol {args.protocol} fixes its robots, tasks and loops; drop "
                      f"{', '.join(given) or '--eval'}")
-  record = continual.execute(profiles.get(args.profile), args.seeds, workers=args.workers)
+  profile = profiles.get(args.profile)
+  record = continual.execute(profile, args.seeds, workers=args.workers, keep_seeds=True)
   print(continual.table(record))
   path = continual.record_path(record, pathlib.Path(args.results))
   run_module.write_record(record, path)
   print(f"result record: {path}")
+  # Only now: a failed write leaves a run that resumes.
+  episode_snapshots.discard_folder(continual.finished_seeds_folder(profile))
   heat_map = plots.forgetting_matrix(continual.mean_forgetting(record), record["robots"],
                                      path.with_name(f"{path.stem}-forgetting.png"))
   print(f"plot: {heat_map}")

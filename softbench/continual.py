@@ -18,6 +18,7 @@ every later stage. A changed score would be forgetting, and raises.
 import dataclasses
 import hashlib
 import pathlib
+import sys
 import time
 
 import numpy as np
@@ -26,6 +27,7 @@ from smpl import progressive
 from smpl import protocol as smpl_protocol
 from smpl import training
 from softbench import data
+from softbench import episode_snapshots
 from softbench import evaluation
 from softbench import metrics
 from softbench import profiles
@@ -157,7 +159,24 @@ def _end_effector_scores(episode: evaluation.Episode, length: float) -> dict:
   return {name: getattr(score, name)[-1].mean for name in METRICS if getattr(score, name)}
 
 
+def finished_seeds_folder(profile: profiles.Profile) -> pathlib.Path:
+  """Where the scores of the seeds an interrupted run finished are kept (``episode_snapshots``:
+  keyed by the settings and the code)."""
+  return episode_snapshots.keyed_folder(
+      f"smpl-{PROTOCOL}", (dataclasses.asdict(profile), protocols.get(PROTOCOL).robot_names))
+
+
 def run_seed(seed: int, profile: profiles.Profile, show_progress: bool = False) -> dict:
+  """``score_seed``, or the scores an interrupted run of the same settings and code kept."""
+  folder = finished_seeds_folder(profile)
+  scores = episode_snapshots.load_scores(folder, seed)
+  if scores is None:
+    scores = score_seed(seed, profile, show_progress)
+    episode_snapshots.save_scores(folder, seed, scores)
+  return scores
+
+
+def score_seed(seed: int, profile: profiles.Profile, show_progress: bool = False) -> dict:
   """Trains (or loads) seed ``seed``'s network and scores every configuration, task and loop.
 
   Returns {"seed", "scores": {loop: {task: [per configuration {metric: value}]}},
@@ -189,16 +208,27 @@ RECORD_VERSION = 2  # 2: sealed with an integrity hash (softbench.leaderboard.ex
 
 
 def execute(profile: profiles.Profile, seeds: int | None = None, show_progress: bool = True,
-            workers: int | None = None) -> dict:
-  """Every seed (in parallel processes), then the result record with full provenance."""
+            workers: int | None = None, keep_seeds: bool = False) -> dict:
+  """Every seed (in parallel processes), then the result record with full provenance.
+
+  Each finished seed's scores are kept until the end, so that an interrupted run resumes with
+  the seeds still to run; unless ``keep_seeds``, they are discarded at the end (else the caller
+  discards them, ``episode_snapshots.discard_folder(finished_seeds_folder(profile))``, once the
+  record is safely written)."""
   from softbench import run  # run imports the agents; imported here to keep this module light.
   started, origin = time.perf_counter(), run.provenance()
   seeds = profile.seeds if seeds is None else seeds
   dataset.check_count("seeds", seeds)
   for arm, _ in protocols.get(PROTOCOL).column_views():  # Every core collects, before the seeds.
     data.collect(arm, samples=profile.samples, seed=learned.DATA_SEED, progress=show_progress)
+  saved = len(list(finished_seeds_folder(profile).glob("seed*.json")))
+  if saved and show_progress:
+    print(f"resuming: {saved} of {seeds} seeds finished before the run was interrupted",
+          file=sys.stderr)
   per_seed = run.over_seeds(run_seed, seeds, (profile,), f"smpl {PROTOCOL}", show_progress,
                             workers)
+  if not keep_seeds:
+    episode_snapshots.discard_folder(finished_seeds_folder(profile))
   return {"format": RECORD_FORMAT, "version": RECORD_VERSION, **origin,
           "protocol": PROTOCOL, "agent": "smpl",
           "robots": list(protocols.get(PROTOCOL).robot_names),

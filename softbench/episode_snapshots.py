@@ -1,16 +1,17 @@
 """The finished seeds of an interrupted ``softbench run``, so that the same command resumes.
 
-A seed's episode is saved (atomically, with a hash of its arrays) as soon as it ends, under
-``softbench_home()/runs/<agent>-<robot>-<task>-<key>/``. The key hashes the run's settings (and
-a custom trajectory file's bytes), the source of ``softbench`` and ``smpl``, the MuJoCo and torch
-versions and the training device, so that a changed setting or changed code never reuses an
-episode. The folder is removed once every seed has run, so a finished command run again
-evaluates afresh.
+A seed's episode (or, for a protocol such as Exp1S, its scores) is saved atomically, with a
+content hash, as soon as it ends, under ``softbench_home()/runs/<name>-<key>/``. The key hashes
+the run's settings (and a custom trajectory file's bytes), the source of ``softbench`` and
+``smpl``, the MuJoCo and torch versions and the training device, so that a changed setting or
+changed code never reuses a seed. The folder is removed once the run's record is written, so a
+finished command run again evaluates afresh.
 """
 
 import dataclasses
 import functools
 import hashlib
+import json
 import pathlib
 import shutil
 import warnings
@@ -48,6 +49,14 @@ def _device() -> str:
   return str(training.default_device())
 
 
+def keyed_folder(name: str, settings) -> pathlib.Path:
+  """``softbench_home()/runs/<name>-<key>``, the key hashing ``settings`` (any value with a
+  stable repr) with the source and library versions."""
+  identity = repr((settings, source_sha256(), mujoco.__version__, torch.__version__, _device()))
+  key = hashlib.sha256(identity.encode()).hexdigest()[:16]
+  return storage.softbench_home() / FOLDER / f"{name}-{key}"
+
+
 def folder(run) -> pathlib.Path:
   """Where the finished seeds of ``run`` (a ``softbench.run.RunSettings``) are kept."""
   trajectory = None  # A file edited under the same name differs; an unreadable one fails later,
@@ -56,29 +65,36 @@ def folder(run) -> pathlib.Path:
       trajectory = hashlib.sha256(pathlib.Path(run.trajectory).read_bytes()).hexdigest()
     except OSError:
       pass
-  identity = repr((dataclasses.asdict(run), trajectory, source_sha256(), mujoco.__version__,
-                   torch.__version__, _device()))
-  key = hashlib.sha256(identity.encode()).hexdigest()[:16]
-  return storage.softbench_home() / FOLDER / f"{run.agent}-{run.robot}-{run.task}-{key}"
+  return keyed_folder(f"{run.agent}-{run.robot}-{run.task}", (dataclasses.asdict(run), trajectory))
 
 
 def _path(run, seed: int) -> pathlib.Path:
   return folder(run) / f"seed{seed}.npz"
 
 
+def _keep(path: pathlib.Path, content: bytes | str, seed: int, what: str) -> None:
+  """Writes a finished seed's file; a failed write (a full disk, or an identical run elsewhere
+  removing the folder as it ends) only warns: the run goes on, and an interrupted one would run
+  the seed again."""
+  try:
+    storage.write_atomically(path, content)
+  except OSError as error:
+    warnings.warn(f"could not keep seed {seed}'s {what} at {path} ({error.strerror or error}); "
+                  "the run goes on without it")
+
+
+def _discard_damaged(path: pathlib.Path, seed: int, what: str, error: Exception) -> None:
+  warnings.warn(f"discarding the saved {what} {path} ({type(error).__name__}: {error}); "
+                f"seed {seed} runs again")
+  path.unlink(missing_ok=True)
+
+
 def save(run, seed: int, episode: evaluation.Episode) -> None:
-  """Keeps ``seed``'s finished ``episode`` until the run ends. A failed write (a full disk, or
-  an identical run elsewhere removing the folder as it ends) only warns: the run goes on, and
-  an interrupted one would run the seed again."""
+  """Keeps ``seed``'s finished ``episode`` until the run ends (a failed write only warns)."""
   arrays = {name: np.asarray(getattr(episode, name)) for name in _ARRAYS}
   arrays["scored_modules"] = np.asarray(episode.scored_modules, dtype=int)
   arrays["sha256"] = np.asarray(storage.arrays_sha256(arrays))
-  path = _path(run, seed)
-  try:
-    storage.write_atomically(path, storage.npz_bytes(arrays))
-  except OSError as error:
-    warnings.warn(f"could not keep seed {seed}'s episode at {path} ({error.strerror or error}); "
-                  "the run goes on without it")
+  _keep(_path(run, seed), storage.npz_bytes(arrays), seed, "episode")
 
 
 def load(run, seed: int) -> evaluation.Episode | None:
@@ -96,13 +112,43 @@ def load(run, seed: int) -> evaluation.Episode | None:
     episode = evaluation.Episode(run.task, tuple(int(k) for k in arrays["scored_modules"]),
                                  *(arrays[name] for name in _ARRAYS))
   except Exception as error:  # Truncated, corrupt or altered: run the seed again.
-    warnings.warn(f"discarding the saved episode {path} ({type(error).__name__}: {error}); "
-                  f"seed {seed} runs again")
-    path.unlink(missing_ok=True)
+    _discard_damaged(path, seed, "episode", error)
     return None
   return episode
 
 
+def _scores_sha256(scores: dict) -> str:
+  return hashlib.sha256(json.dumps(scores, sort_keys=True).encode()).hexdigest()
+
+
+def save_scores(folder: pathlib.Path, seed: int, scores: dict) -> None:
+  """Keeps ``seed``'s finished ``scores`` (JSON-serialisable) in ``folder`` until the run ends
+  (a failed write only warns)."""
+  text = json.dumps({"scores": scores, "sha256": _scores_sha256(scores)})
+  _keep(folder / f"seed{seed}.json", text, seed, "scores")
+
+
+def load_scores(folder: pathlib.Path, seed: int) -> dict | None:
+  """``seed``'s scores saved in ``folder`` by an interrupted run, or None; an unreadable or
+  altered file is deleted with a warning (the seed then runs again)."""
+  path = folder / f"seed{seed}.json"
+  if not path.exists():
+    return None
+  try:
+    saved = json.loads(path.read_text())
+    if saved["sha256"] != _scores_sha256(saved["scores"]):
+      raise ValueError("content hash mismatch")
+  except Exception as error:  # Truncated, corrupt or altered: run the seed again.
+    _discard_damaged(path, seed, "scores", error)
+    return None
+  return saved["scores"]
+
+
 def discard(run) -> None:
   """Removes the finished seeds of ``run`` once its record no longer needs them."""
-  shutil.rmtree(folder(run), ignore_errors=True)
+  discard_folder(folder(run))
+
+
+def discard_folder(path: pathlib.Path) -> None:
+  """Removes a folder of finished seeds (``keyed_folder``) once the record no longer needs it."""
+  shutil.rmtree(path, ignore_errors=True)

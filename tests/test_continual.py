@@ -52,6 +52,7 @@ def test_exp1s_end_to_end(two_stages, tmp_path, capsys):
   assert matrix[1] == closed_spiral
   model_level = seed["forgetting_model_pose_mse"]
   assert model_level[1][0] == model_level[0][0] and model_level[0][1] is None
+  assert not continual.finished_seeds_folder(profiles.get("tiny")).exists()  # Once written.
   # The second run reuses the cached network and gives the same scores.
   again = tmp_path / "again.json"
   assert cli.main([*argv, "--json", str(again)]) == 0
@@ -122,3 +123,34 @@ def test_a_damaged_cached_network_is_trained_again(two_stages, tmp_path,
   np.testing.assert_array_equal(again.forgetting_pose_mse, first.forgetting_pose_mse)
   np.testing.assert_array_equal(continual.build(0, tiny).forgetting_action_mse,
                                 first.forgetting_action_mse)  # Loaded from the new file.
+
+
+def test_an_interrupted_exp1s_resumes_from_its_finished_seeds(two_stages, monkeypatch):
+  tiny, scored, score_seed = profiles.get("tiny"), [], continual.score_seed
+
+  def counting(seed, profile, show_progress=False):
+    scored.append(seed)
+    if seed == 1 and len(scored) == 2:  # The first run stops as seed 1 starts.
+      raise KeyboardInterrupt
+    return score_seed(seed, profile, show_progress)
+
+  monkeypatch.setattr(continual, "score_seed", counting)
+  with pytest.raises(KeyboardInterrupt):
+    continual.execute(tiny, seeds=2, show_progress=False, workers=1)
+  assert (continual.finished_seeds_folder(tiny) / "seed0.json").exists()
+  resumed = continual.execute(tiny, seeds=2, show_progress=False, workers=1)
+  assert scored == [0, 1, 1]  # Seed 0 was not scored again.
+  assert not continual.finished_seeds_folder(tiny).exists()
+  fresh = continual.execute(tiny, seeds=2, show_progress=False, workers=1)
+  assert scored == [0, 1, 1, 0, 1]
+  assert resumed["per_seed"] == fresh["per_seed"]
+
+
+def test_damaged_saved_exp1s_scores_run_the_seed_again(two_stages):
+  tiny = profiles.get("tiny")
+  expected = continual.run_seed(0, tiny)
+  path = continual.finished_seeds_folder(tiny) / "seed0.json"
+  path.write_text(path.read_text().replace('"seed": 0', '"seed": 7'))
+  with pytest.warns(UserWarning, match="discarding the saved scores"):
+    assert continual.run_seed(0, tiny) == expected
+  assert json.loads(path.read_text())["scores"] == expected  # Saved again.
