@@ -18,7 +18,6 @@ every later stage. A changed score would be forgetting, and raises.
 import dataclasses
 import hashlib
 import pathlib
-import sys
 import time
 
 import numpy as np
@@ -221,10 +220,8 @@ def execute(profile: profiles.Profile, seeds: int | None = None, show_progress: 
   dataset.check_count("seeds", seeds)
   for arm, _ in protocols.get(PROTOCOL).column_views():  # Every core collects, before the seeds.
     data.collect(arm, samples=profile.samples, seed=learned.DATA_SEED, progress=show_progress)
-  saved = len(list(finished_seeds_folder(profile).glob("seed*.json")))
-  if saved and show_progress:
-    print(f"resuming: {saved} of {seeds} seeds finished before the run was interrupted",
-          file=sys.stderr)
+  if show_progress:
+    episode_snapshots.report_resuming(finished_seeds_folder(profile), seeds)
   per_seed = run.over_seeds(run_seed, seeds, (profile,), f"smpl {PROTOCOL}", show_progress,
                             workers)
   if not keep_seeds:

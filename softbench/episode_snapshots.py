@@ -14,6 +14,7 @@ import hashlib
 import json
 import pathlib
 import shutil
+import sys
 import warnings
 
 import mujoco
@@ -70,6 +71,14 @@ def folder(run) -> pathlib.Path:
 
 def _path(run, seed: int) -> pathlib.Path:
   return folder(run) / f"seed{seed}.npz"
+
+
+def report_resuming(path: pathlib.Path, seeds: int) -> None:
+  """Says on stderr how many of ``seeds`` seeds an interrupted run left in ``path``, if any."""
+  saved = len(list(path.glob("seed*")))
+  if saved:
+    print(f"resuming: {saved} of {seeds} seeds finished before the run was interrupted",
+          file=sys.stderr)
 
 
 def _keep(path: pathlib.Path, content: bytes | str, seed: int, what: str) -> None:

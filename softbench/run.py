@@ -24,7 +24,6 @@ import pathlib
 import platform
 import signal
 import subprocess
-import sys
 import threading
 import time
 import warnings
@@ -371,10 +370,8 @@ def execute_episodes(run: RunSettings, show_progress: bool = True, workers: int 
     results = {"scored_modules": [section["target_module"]], "per_seed": [],
                "adaptive": section}
   else:
-    saved = len(list(episode_snapshots.folder(run).glob("seed*.npz")))
-    if saved and show_progress:
-      print(f"resuming: {saved} of {run.seeds} seeds finished before the run was "
-            f"interrupted", file=sys.stderr)
+    if show_progress:
+      episode_snapshots.report_resuming(episode_snapshots.folder(run), run.seeds)
     outcomes = over_seeds(_run_seed, run.seeds, (run,), f"{run.agent} on {run.task}",
                           show_progress, workers)
     if not keep_seeds:
