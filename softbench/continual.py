@@ -18,6 +18,7 @@ every later stage. A changed score would be forgetting, and raises.
 import dataclasses
 import hashlib
 import pathlib
+import sys
 import time
 
 import numpy as np
@@ -159,24 +160,40 @@ def _end_effector_scores(episode: evaluation.Episode, length: float) -> dict:
 
 
 def finished_seeds_folder(profile: profiles.Profile) -> pathlib.Path:
-  """Where the scores of the seeds an interrupted run finished are kept (``episode_snapshots``:
-  keyed by the settings and the code)."""
+  """Where the scores of the seeds (and, under ``EPISODES_FOLDER``, of the episodes) that an
+  interrupted run finished are kept (``episode_snapshots``: keyed by the settings and the code)."""
   return episode_snapshots.keyed_folder(
       f"smpl-{PROTOCOL}", (dataclasses.asdict(profile), protocols.get(PROTOCOL).robot_names))
 
 
+EPISODES_FOLDER = "episodes"  # Inside finished_seeds_folder: the finished episodes of a seed.
+
+
 def run_seed(seed: int, profile: profiles.Profile, show_progress: bool = False) -> dict:
-  """``score_seed``, or the scores an interrupted run of the same settings and code kept."""
+  """``score_seed``, or the scores an interrupted run of the same settings and code kept: the
+  seed's, or those of each episode it had finished."""
   folder = finished_seeds_folder(profile)
-  scores = episode_snapshots.load_scores(folder, seed)
+  path, subject = folder / f"seed{seed}.json", f"seed {seed}"
+  scores = episode_snapshots.load_scores(path, subject)
   if scores is None:
-    scores = score_seed(seed, profile, show_progress)
-    episode_snapshots.save_scores(folder, seed, scores)
+    episodes = folder / EPISODES_FOLDER
+    kept = len(list(episodes.glob(f"seed{seed}-*.json")))
+    if kept and show_progress:
+      total = len(protocols.get(PROTOCOL).robot_names) * len(LOOPS) * len(TASKS)
+      print(f"resuming seed {seed}: {kept} of its {total} episodes finished before the run was "
+            "interrupted", file=sys.stderr)
+    scores = score_seed(seed, profile, show_progress, episodes)
+    episode_snapshots.save_scores(path, scores, subject)
   return scores
 
 
-def score_seed(seed: int, profile: profiles.Profile, show_progress: bool = False) -> dict:
+def score_seed(seed: int, profile: profiles.Profile, show_progress: bool = False,
+               kept_episodes: pathlib.Path | None = None) -> dict:
   """Trains (or loads) seed ``seed``'s network and scores every configuration, task and loop.
+
+  With ``kept_episodes``, each episode's scores are kept there as it ends, and an episode whose
+  scores are there already is not run again (they do not depend on the order: every episode
+  starts from a reset agent and a fresh environment).
 
   Returns {"seed", "scores": {loop: {task: [per configuration {metric: value}]}},
   "forgetting_model_pose_mse", "forgetting_tip_percent"} (matrices as nested lists, NaN -> None).
@@ -190,9 +207,17 @@ def score_seed(seed: int, profile: profiles.Profile, show_progress: bool = False
     for loop, error_source in LOOPS.items():
       agent.error_source = error_source
       for task in TASKS:
-        env = suite.load(arm, task, seed=seed, **profile.episode_options(task))
-        episode = evaluation.run_episode(env, agent, task, show_progress)
-        scores[loop][task].append(_end_effector_scores(episode, arm.length))
+        name = f"seed{seed}-configuration{configuration}-{loop}-{task}"
+        subject = f"seed {seed}'s {loop}-loop {task} episode of configuration {configuration}"
+        path = kept_episodes / f"{name}.json" if kept_episodes else None
+        entry = episode_snapshots.load_scores(path, subject) if path else None
+        if entry is None:
+          env = suite.load(arm, task, seed=seed, **profile.episode_options(task))
+          episode = evaluation.run_episode(env, agent, task, show_progress)
+          entry = _end_effector_scores(episode, arm.length)
+          if path:
+            episode_snapshots.save_scores(path, entry, subject)
+        scores[loop][task].append(entry)
   tip = [entry["normalised_tip_percent"] for entry in scores["closed"][FORGETTING_TASK]]
   stages = len(model.arms)
   physics = [[tip[c] if c <= s else None for c in range(stages)] for s in range(stages)]

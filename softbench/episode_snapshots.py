@@ -1,7 +1,7 @@
 """The finished seeds of an interrupted ``softbench run``, so that the same command resumes.
 
-A seed's episode (or, for a protocol such as Exp1S, its scores) is saved atomically, with a
-content hash, as soon as it ends, under ``softbench_home()/runs/<name>-<key>/``. The key hashes
+A seed's episode (or, for Exp1S, the scores of the seed and of each of its episodes) is saved
+atomically, with a content hash, as soon as it ends, under ``softbench_home()/runs/<name>-<key>/``. The key hashes
 the run's settings (and a custom trajectory file's bytes), the source of ``softbench`` and
 ``smpl``, the MuJoCo and torch versions and the training device, so that a changed setting or
 changed code never reuses a seed. The folder is removed once the run's record is written, so a
@@ -81,20 +81,20 @@ def report_resuming(path: pathlib.Path, seeds: int) -> None:
           file=sys.stderr)
 
 
-def _keep(path: pathlib.Path, content: bytes | str, seed: int, what: str) -> None:
-  """Writes a finished seed's file; a failed write (a full disk, or an identical run elsewhere
-  removing the folder as it ends) only warns: the run goes on, and an interrupted one would run
-  the seed again."""
+def _keep(path: pathlib.Path, content: bytes | str, subject: str, what: str) -> None:
+  """Writes the file of a finished ``subject`` (a seed, an episode); a failed write (a full disk,
+  or an identical run elsewhere removing the folder as it ends) only warns: the run goes on, and
+  an interrupted one would run ``subject`` again."""
   try:
     storage.write_atomically(path, content)
   except OSError as error:
-    warnings.warn(f"could not keep seed {seed}'s {what} at {path} ({error.strerror or error}); "
-                  "the run goes on without it")
+    warnings.warn(f"could not keep the {what} of {subject} at {path} "
+                  f"({error.strerror or error}); the run goes on without it")
 
 
-def _discard_damaged(path: pathlib.Path, seed: int, what: str, error: Exception) -> None:
+def _discard_damaged(path: pathlib.Path, subject: str, what: str, error: Exception) -> None:
   warnings.warn(f"discarding the saved {what} {path} ({type(error).__name__}: {error}); "
-                f"seed {seed} runs again")
+                f"{subject} runs again")
   path.unlink(missing_ok=True)
 
 
@@ -103,7 +103,7 @@ def save(run, seed: int, episode: evaluation.Episode) -> None:
   arrays = {name: np.asarray(getattr(episode, name)) for name in _ARRAYS}
   arrays["scored_modules"] = np.asarray(episode.scored_modules, dtype=int)
   arrays["sha256"] = np.asarray(storage.arrays_sha256(arrays))
-  _keep(_path(run, seed), storage.npz_bytes(arrays), seed, "episode")
+  _keep(_path(run, seed), storage.npz_bytes(arrays), f"seed {seed}", "episode")
 
 
 def load(run, seed: int) -> evaluation.Episode | None:
@@ -121,7 +121,7 @@ def load(run, seed: int) -> evaluation.Episode | None:
     episode = evaluation.Episode(run.task, tuple(int(k) for k in arrays["scored_modules"]),
                                  *(arrays[name] for name in _ARRAYS))
   except Exception as error:  # Truncated, corrupt or altered: run the seed again.
-    _discard_damaged(path, seed, "episode", error)
+    _discard_damaged(path, f"seed {seed}", "episode", error)
     return None
   return episode
 
@@ -130,25 +130,24 @@ def _scores_sha256(scores: dict) -> str:
   return hashlib.sha256(json.dumps(scores, sort_keys=True).encode()).hexdigest()
 
 
-def save_scores(folder: pathlib.Path, seed: int, scores: dict) -> None:
-  """Keeps ``seed``'s finished ``scores`` (JSON-serialisable) in ``folder`` until the run ends
-  (a failed write only warns)."""
+def save_scores(path: pathlib.Path, scores: dict, subject: str) -> None:
+  """Keeps the finished ``scores`` (JSON-serialisable) of ``subject`` (a seed, an episode) at
+  ``path`` until the run ends (a failed write only warns)."""
   text = json.dumps({"scores": scores, "sha256": _scores_sha256(scores)})
-  _keep(folder / f"seed{seed}.json", text, seed, "scores")
+  _keep(path, text, subject, "scores")
 
 
-def load_scores(folder: pathlib.Path, seed: int) -> dict | None:
-  """``seed``'s scores saved in ``folder`` by an interrupted run, or None; an unreadable or
-  altered file is deleted with a warning (the seed then runs again)."""
-  path = folder / f"seed{seed}.json"
+def load_scores(path: pathlib.Path, subject: str) -> dict | None:
+  """The scores of ``subject`` that an interrupted run saved at ``path``, or None; an unreadable
+  or altered file is deleted with a warning (``subject`` then runs again)."""
   if not path.exists():
     return None
   try:
     saved = json.loads(path.read_text())
     if saved["sha256"] != _scores_sha256(saved["scores"]):
       raise ValueError("content hash mismatch")
-  except Exception as error:  # Truncated, corrupt or altered: run the seed again.
-    _discard_damaged(path, seed, "scores", error)
+  except Exception as error:  # Truncated, corrupt or altered: run it again.
+    _discard_damaged(path, subject, "scores", error)
     return None
   return saved["scores"]
 

@@ -10,6 +10,7 @@ import torch
 from softbench import cli
 from softbench import continual
 from softbench import data
+from softbench import episode_snapshots
 from softbench import profiles
 from softbench import protocols
 from softbench.agents import learned
@@ -128,11 +129,11 @@ def test_a_damaged_cached_network_is_trained_again(two_stages, tmp_path,
 def test_an_interrupted_exp1s_resumes_from_its_finished_seeds(two_stages, monkeypatch):
   tiny, scored, score_seed = profiles.get("tiny"), [], continual.score_seed
 
-  def counting(seed, profile, show_progress=False):
+  def counting(seed, profile, show_progress=False, kept_episodes=None):
     scored.append(seed)
     if seed == 1 and len(scored) == 2:  # The first run stops as seed 1 starts.
       raise KeyboardInterrupt
-    return score_seed(seed, profile, show_progress)
+    return score_seed(seed, profile, show_progress, kept_episodes)
 
   monkeypatch.setattr(continual, "score_seed", counting)
   with pytest.raises(KeyboardInterrupt):
@@ -146,7 +147,35 @@ def test_an_interrupted_exp1s_resumes_from_its_finished_seeds(two_stages, monkey
   assert resumed["per_seed"] == fresh["per_seed"]
 
 
-def test_damaged_saved_exp1s_scores_run_the_seed_again(two_stages):
+def test_a_seed_interrupted_in_its_evaluation_resumes_from_its_finished_episodes(
+    two_stages, monkeypatch, capsys):
+  tiny, episodes, run_episode = profiles.get("tiny"), [], continual.evaluation.run_episode
+  total = len(STAGES) * len(continual.LOOPS) * len(continual.TASKS)
+  finished_before_interruption = 5
+
+  def counting(env, agent, task, show_progress=False):
+    if len(episodes) == finished_before_interruption and not resumed:
+      raise KeyboardInterrupt
+    episodes.append((agent.robot.name, agent.error_source, task))
+    return run_episode(env, agent, task, show_progress)
+
+  monkeypatch.setattr(continual.evaluation, "run_episode", counting)
+  resumed = False
+  with pytest.raises(KeyboardInterrupt):
+    continual.run_seed(0, tiny)
+  kept = continual.finished_seeds_folder(tiny) / continual.EPISODES_FOLDER
+  assert len(list(kept.glob("seed0-*.json"))) == finished_before_interruption
+  resumed = True
+  scores = continual.run_seed(0, tiny, show_progress=True)
+  assert (f"resuming seed 0: {finished_before_interruption} of its {total} episodes"
+          in capsys.readouterr().err)
+  assert len(episodes) == total and len(set(episodes)) == total  # None ran twice.
+  episode_snapshots.discard_folder(continual.finished_seeds_folder(tiny))
+  assert continual.run_seed(0, tiny) == scores  # Uninterrupted: the same scores.
+  assert len(episodes) == 2 * total
+
+
+def test_damaged_saved_exp1s_scores_run_again(two_stages, monkeypatch):
   tiny = profiles.get("tiny")
   expected = continual.run_seed(0, tiny)
   path = continual.finished_seeds_folder(tiny) / "seed0.json"
@@ -154,3 +183,14 @@ def test_damaged_saved_exp1s_scores_run_the_seed_again(two_stages):
   with pytest.warns(UserWarning, match="discarding the saved scores"):
     assert continual.run_seed(0, tiny) == expected
   assert json.loads(path.read_text())["scores"] == expected  # Saved again.
+  # With the seed's file gone, a damaged episode's file runs that episode alone again.
+  path.unlink()
+  episode = continual.finished_seeds_folder(tiny) / continual.EPISODES_FOLDER / (
+      "seed0-configuration2-closed-spiral.json")
+  episode.write_text(episode.read_text()[:-5])  # Truncated.
+  ran, run_episode = [], continual.evaluation.run_episode
+  monkeypatch.setattr(continual.evaluation, "run_episode",
+                      lambda *arguments: ran.append(arguments[2]) or run_episode(*arguments))
+  with pytest.warns(UserWarning, match="discarding the saved scores .*configuration2-closed-spiral"):
+    assert continual.run_seed(0, tiny) == expected
+  assert ran == ["spiral"]
