@@ -37,8 +37,12 @@ class SoftArmPhysics(mujoco.Physics):
 
   @property
   def num_modules(self) -> int:
-    names = {self.model.site(i).name for i in range(self.model.nsite)}
-    return sum(1 for k in range(1, len(names) + 1) if chain.tip_site_name(k) in names)
+    """How many tip sites ``module1_tip``, ``module2_tip``, ... the model has (by name lookup:
+    rewards read this every step)."""
+    count = 0
+    while mj.mj_name2id(self.model.ptr, mj.mjtObj.mjOBJ_SITE, chain.tip_site_name(count + 1)) >= 0:
+      count += 1
+    return count
 
   def set_action(self, action: np.ndarray) -> None:
     """Sets the controls of every actuator from an action in [-1, 1]^action_dim.
