@@ -1,11 +1,11 @@
 """The finished seeds of an interrupted ``softbench run``, so that the same command resumes.
 
 A seed's episode (or, for Exp1S, the scores of the seed and of each of its episodes) is saved
-atomically, with a content hash, as soon as it ends, under ``softbench_home()/runs/<name>-<key>/``. The key hashes
-the run's settings (and a custom trajectory file's bytes), the source of ``softbench`` and
-``smpl``, the MuJoCo and torch versions and the training device, so that a changed setting or
-changed code never reuses a seed. The folder is removed once the run's record is written, so a
-finished command run again evaluates afresh.
+atomically, with a content hash, as soon as it ends, under ``softbench_home()/runs/<name>-<key>/``.
+The key hashes the run's settings (and a custom trajectory file's bytes), the source of
+``softbench`` and ``smpl``, the MuJoCo and torch versions and the training device, so that a
+changed setting or changed code never reuses a seed. The folder is removed once the run's record
+is written, so a finished command run again evaluates afresh.
 """
 
 import dataclasses
