@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
+from softbench import agents
 from softbench import cli
 from softbench import leaderboard
 from softbench import run
@@ -278,6 +279,8 @@ def test_the_overview_shows_every_plain_task_of_every_agent(results):
       shown += 1
   assert shown == 5 and rows["good"][1] == "-"  # Good has no reach record.
   assert "no table for this robot" in view.table.caption
+  unrecorded = [agent for agent in agents.AGENTS if agent != "zero"]
+  assert view.table.caption.endswith(f"; no record yet of {', '.join(unrecorded)}")
 
 
 def test_the_overview_shows_the_papers_value_beside_ours(real_record, tmp_path):

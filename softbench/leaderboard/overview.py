@@ -2,10 +2,10 @@
 
 One table per robot, profile (paper first) and eval mode (physics first): agents by rows
 (registry order, then any others by name), the tasks that have a record by columns (suite
-order). A cell is the position error (mm) of the row that the task's ranking shows for that
-agent, profile and eval mode (its newest record): mean ± std over seeds of the episode's
-module-averaged error. Where the paper reports
-the same robot, task and agent (``paper_exp2.json``: Exp2S for tendon-3, Exp2R for
+order); the caption names the registered agents without a record there. A cell is the position
+error (mm) of the row that the task's ranking shows for that agent, profile and eval mode (its
+newest record): mean ± std over seeds of the episode's module-averaged error. Where the paper
+reports the same robot, task and agent (``paper_exp2.json``: Exp2S for tendon-3, Exp2R for
 pneumatic-433), the paper's mean follows in brackets. Only plain tasks count: a custom
 trajectory, a fault or an extra section is a different experiment.
 """
@@ -84,6 +84,9 @@ def overviews(board: ranking.Leaderboard) -> tuple[Overview, ...]:
     caption = ("position error (mm), mean ± std over seeds of the module-averaged error; " +
                (f"in brackets the paper's {experiment['name']} mean" if experiment else
                 "the paper has no table for this robot"))
+    missing = [agent for agent in agents.AGENTS if agent not in names]
+    if missing:
+      caption += f"; no record yet of {', '.join(missing)}"
     rows = tuple((agent, *(_cell(estimates[agent, task], paper_mean(robot, task, agent))
                            if (agent, task) in estimates else "-" for task in tasks))
                  for agent in names)
