@@ -68,8 +68,7 @@ def test_forgetting_is_detected():
     continual.check_no_forgetting(matrix)
 
 
-def test_detected_forgetting_is_one_line_and_a_failure(monkeypatch, tmp_path, capsys):
-  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / "home"))
+def test_detected_forgetting_is_one_line_and_a_failure(two_stages, monkeypatch, tmp_path, capsys):
   changed = np.array([[0.5, np.nan], [0.25, 0.2]])
   monkeypatch.setattr(continual, "run_seed",
                       lambda *arguments: continual.check_no_forgetting(changed))
