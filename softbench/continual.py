@@ -187,12 +187,12 @@ def run_seed(seed: int, profile: profiles.Profile, show_progress: bool = False) 
   return scores
 
 
-def score_seed(seed: int, profile: profiles.Profile, show_progress: bool = False,
-               kept_episodes: pathlib.Path | None = None) -> dict:
+def score_seed(seed: int, profile: profiles.Profile, show_progress: bool,
+               kept_episodes: pathlib.Path) -> dict:
   """Trains (or loads) seed ``seed``'s network and scores every configuration, task and loop.
 
-  With ``kept_episodes``, each episode's scores are kept there as it ends, and an episode whose
-  scores are there already is not run again (they do not depend on the order: every episode
+  Each episode's scores are kept in ``kept_episodes`` as it ends, and an episode whose scores
+  are there already is not run again (they do not depend on the order: every episode
   starts from a reset agent and a fresh environment).
 
   Returns {"seed", "scores": {loop: {task: [per configuration {metric: value}]}},
@@ -209,14 +209,13 @@ def score_seed(seed: int, profile: profiles.Profile, show_progress: bool = False
       for task in TASKS:
         name = f"seed{seed}-configuration{configuration}-{loop}-{task}"
         subject = f"seed {seed}'s {loop}-loop {task} episode of configuration {configuration}"
-        path = kept_episodes / f"{name}.json" if kept_episodes else None
-        entry = episode_snapshots.load_scores(path, subject) if path else None
+        path = kept_episodes / f"{name}.json"
+        entry = episode_snapshots.load_scores(path, subject)
         if entry is None:
           env = suite.load(arm, task, seed=seed, **profile.episode_options(task))
           episode = evaluation.run_episode(env, agent, task, show_progress)
           entry = _end_effector_scores(episode, arm.length)
-          if path:
-            episode_snapshots.save_scores(path, entry, subject)
+          episode_snapshots.save_scores(path, entry, subject)
         scores[loop][task].append(entry)
   tip = [entry["normalised_tip_percent"] for entry in scores["closed"][FORGETTING_TASK]]
   stages = len(model.arms)

@@ -128,7 +128,7 @@ def test_a_damaged_cached_network_is_trained_again(two_stages, tmp_path,
 def test_an_interrupted_exp1s_resumes_from_its_finished_seeds(two_stages, monkeypatch):
   tiny, scored, score_seed = profiles.get("tiny"), [], continual.score_seed
 
-  def counting(seed, profile, show_progress=False, kept_episodes=None):
+  def counting(seed, profile, show_progress, kept_episodes):
     scored.append(seed)
     if seed == 1 and len(scored) == 2:  # The first run stops as seed 1 starts.
       raise KeyboardInterrupt
