@@ -271,7 +271,8 @@ def _add_video_arguments(parser: argparse.ArgumentParser) -> None:
                            f"{video_options.DEFAULT_CAMERA})")
   parser.add_argument("--frames-per-step",
                       help="frames per control step, to show the motion within each step "
-                           "(default 1: the pose at the end of every step)")
+                           "(default 1: the pose at the end of every step, after a frame of "
+                           "the start)")
 
 
 def _add_profile_argument(parser: argparse.ArgumentParser) -> None:
@@ -321,8 +322,9 @@ def _retrain(args: argparse.Namespace) -> None:
 
 
 _FAULT_HELP = ("a faulty actuator, MODULE:ACTUATOR:GAIN (module from 1, actuator from 0 within "
-               "the module: cable xpos, ypos, xneg, yneg of a tendon arm, bellows 1.. of the "
-               "pneumatic arm; gain in [0, 1], 0 punctured); repeat for several")
+               "the module: cable xpos, ypos, xneg, yneg of a tendon arm, bellows 0.. (MJCF "
+               "bellows1..) of the pneumatic arm; gain in [0, 1], 0 punctured); repeat for "
+               "several")
 
 
 class _OneLineErrorParser(argparse.ArgumentParser):

@@ -80,7 +80,7 @@ class TendonArm(base.SoftArm):
   density: float = 1100.0
   cable_offset: float = 0.006
   pass_through_offset: float = 0.002
-  max_tension: float = 2.58  # Bends tendon-1 by 89.9 deg (bisection on measure.bend_angle).
+  max_tension: float = 2.58  # Bends tendon-1 by 89.8 deg (bisection on measure.bend_angle).
   damping: float = 2.0e-3
   medium_viscosity: float = 0.1
   armature: float = 1.0e-5
