@@ -1,14 +1,19 @@
 """The scripts behind README figures (docs/analysis) keep running against the current API, on tiny
 data; the early-stopping script's best-validation agent is the one `softbench run` trains."""
 
+import dataclasses
 import importlib.util
+import json
 import pathlib
 import re
 import sys
 
 import pytest
 
+from softbench import cli
+from softbench import continual
 from softbench import data
+from softbench import protocols
 from softbench import run
 
 ANALYSIS = pathlib.Path(__file__).parent.parent / "docs" / "analysis"
@@ -62,3 +67,24 @@ def test_validation_loss_reports_every_seed_of_every_agent(monkeypatch, capsys):
   assert all(0 < float(validation) < 10 and 0 < float(test) < 10
              for _, validation, test in losses)
   assert losses[0][1:] != losses[1][1:]  # Each seed its own model.
+
+
+def test_exp1s_column_retrains_the_column_exp1s_trained(monkeypatch, capsys, tmp_path):
+  stages = ("tendon-1", "tendon-2")  # Two stages instead of five, as in test_continual.
+  short = dataclasses.replace(protocols.PROTOCOLS[continual.PROTOCOL], robot_names=stages)
+  monkeypatch.setitem(protocols.PROTOCOLS, continual.PROTOCOL, short)
+  results = tmp_path / "results"
+  assert cli.main(["run", "--protocol", "exp1s", "--agent", "smpl", "--profile", "tiny",
+                   "--seeds", "1", "--results", str(results)]) == 0
+  (path,) = results.glob("smpl-exp1s-tiny-*.json")
+  spiral = json.loads(path.read_text())["per_seed"][0]["scores"]["closed"]["spiral"][1]
+  capsys.readouterr()
+  # The tiny profile trains 2 epochs without stopping early: the run's own settings.
+  out = run_script("exp1s_column", ["--configuration", "2", "--seed", "0", "--profile", "tiny",
+                                    "--epochs", "2", "--settings", "tuned:0", "tuned:1",
+                                    "--tasks", "spiral"], monkeypatch, capsys)
+  scores = re.findall(r"pose-loss weight (\d+): tendon-2 spiral, closed loop in physics: end "
+                      r"effector ([0-9.]+) mm, ([0-9.]+) deg", out)
+  assert [weight for weight, _, _ in scores] == ["0", "1"]
+  assert scores[0][1:] == (f"{spiral['position_mm']:.2f}", f"{spiral['orientation_deg']:.2f}")
+  assert len(re.findall(r"best validation [0-9.]+ at epoch [12]; test action MSE", out)) == 2
