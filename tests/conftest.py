@@ -1,13 +1,26 @@
 """Fixtures shared by the test files."""
 
+import dataclasses
 import os
 import subprocess
 import sys
 
 import pytest
 
+from softbench import continual
 from softbench import data
 from softbench import leaderboard
+from softbench import protocols
+
+
+@pytest.fixture
+def two_stages(monkeypatch, tmp_path):
+  """Exp1S on tendon-1 then tendon-2 instead of tendon-1 .. 5, in a fresh data home; the stages."""
+  stages = ("tendon-1", "tendon-2")
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / "home"))
+  short = dataclasses.replace(protocols.PROTOCOLS[continual.PROTOCOL], robot_names=stages)
+  monkeypatch.setitem(protocols.PROTOCOLS, continual.PROTOCOL, short)
+  return stages
 
 
 @pytest.fixture

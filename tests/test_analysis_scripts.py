@@ -1,7 +1,6 @@
 """The scripts behind README figures (docs/analysis) keep running against the current API, on tiny
 data; the early-stopping script's best-validation agent is the one `softbench run` trains."""
 
-import dataclasses
 import importlib.util
 import json
 import pathlib
@@ -11,9 +10,7 @@ import sys
 import pytest
 
 from softbench import cli
-from softbench import continual
 from softbench import data
-from softbench import protocols
 from softbench import run
 
 ANALYSIS = pathlib.Path(__file__).parent.parent / "docs" / "analysis"
@@ -69,10 +66,8 @@ def test_validation_loss_reports_every_seed_of_every_agent(monkeypatch, capsys):
   assert losses[0][1:] != losses[1][1:]  # Each seed its own model.
 
 
-def test_exp1s_column_retrains_the_column_exp1s_trained(monkeypatch, capsys, tmp_path):
-  stages = ("tendon-1", "tendon-2")  # Two stages instead of five, as in test_continual.
-  short = dataclasses.replace(protocols.PROTOCOLS[continual.PROTOCOL], robot_names=stages)
-  monkeypatch.setitem(protocols.PROTOCOLS, continual.PROTOCOL, short)
+def test_exp1s_column_retrains_the_column_exp1s_trained(two_stages, monkeypatch, capsys,
+                                                       tmp_path):
   results = tmp_path / "results"
   assert cli.main(["run", "--protocol", "exp1s", "--agent", "smpl", "--profile", "tiny",
                    "--seeds", "1", "--results", str(results)]) == 0

@@ -1,6 +1,5 @@
 """Exp1S in physics (``softbench run --protocol exp1s``) on a two-stage sequence, tiny profile."""
 
-import dataclasses
 import json
 
 import numpy as np
@@ -12,19 +11,8 @@ from softbench import continual
 from softbench import data
 from softbench import episode_snapshots
 from softbench import profiles
-from softbench import protocols
 from softbench.agents import learned
 from softbench.leaderboard import records
-
-STAGES = ("tendon-1", "tendon-2")
-
-
-@pytest.fixture
-def two_stages(monkeypatch, tmp_path):
-  """tendon-1 then tendon-2 instead of tendon-1 .. 5, in a fresh data home."""
-  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / "home"))
-  short = dataclasses.replace(protocols.PROTOCOLS[continual.PROTOCOL], robot_names=STAGES)
-  monkeypatch.setitem(protocols.PROTOCOLS, continual.PROTOCOL, short)
 
 
 def test_exp1s_end_to_end(two_stages, tmp_path, capsys):
@@ -40,12 +28,12 @@ def test_exp1s_end_to_end(two_stages, tmp_path, capsys):
   assert path.with_name(f"{path.stem}-forgetting.png").stat().st_size > 0
   record = records.read(path)  # Checked: schema, integrity hash, consistency.
   assert record == json.loads(path.read_text()) and record["version"] == continual.RECORD_VERSION
-  assert record["robots"] == list(STAGES) and record["seeds"] == 1
+  assert record["robots"] == list(two_stages) and record["seeds"] == 1
   (seed,) = record["per_seed"]
   for loop in continual.LOOPS:
     for task in continual.TASKS:
       entries = seed["scores"][loop][task]
-      assert len(entries) == len(STAGES)
+      assert len(entries) == len(two_stages)
       assert all(np.isfinite(entry[name]) for entry in entries for name in continual.METRICS)
   matrix = seed["forgetting_tip_percent"]
   assert matrix[0][1] is None and matrix[1][0] == matrix[0][0]
@@ -149,7 +137,7 @@ def test_an_interrupted_exp1s_resumes_from_its_finished_seeds(two_stages, monkey
 def test_a_seed_interrupted_in_its_evaluation_resumes_from_its_finished_episodes(
     two_stages, monkeypatch, capsys):
   tiny, episodes, run_episode = profiles.get("tiny"), [], continual.evaluation.run_episode
-  total = len(STAGES) * len(continual.LOOPS) * len(continual.TASKS)
+  total = len(two_stages) * len(continual.LOOPS) * len(continual.TASKS)
   finished_before_interruption = 5
 
   def counting(env, agent, task, show_progress=False):
