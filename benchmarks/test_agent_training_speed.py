@@ -1,8 +1,9 @@
 """Closed-loop training speed of every learned agent at the paper's data size, on one CPU thread.
 
-Run with `make bench`. Each case trains an agent's inverse model exactly as `softbench run` does
+Run with `make bench`. Each case trains an agent's inverse model as `softbench run` does
 (`learned.train_inverse`: its committed hyperparameters, views, forward model sizes and the paper
-profile's compile setting) for two epochs on random babbling of the paper's size (14,000 samples in
+profile's compile setting; only the restart of a diverged training is off, so that every case
+times the same epochs) for two epochs on random babbling of the paper's size (14,000 samples in
 10 episodes, cut by the real splitter: 9,800 training and 1,400 validation samples per view). The
 values are random and the forward models untrained, which changes no operation count. The figure
 to read is `extra_info["steady_epoch_s"]`: the second epoch of each model (the first one also
