@@ -63,8 +63,9 @@ def _robots(args: argparse.Namespace) -> None:
 
 def _models_export(args: argparse.Namespace) -> None:
   out = pathlib.Path(args.out)
-  for name in robots.BENCHMARK_ROBOTS:
-    for path in model_export.export(robots.make(name), out, args.measure_speed):
+  chosen = [robots.make(name) for name in args.robots or robots.BENCHMARK_ROBOTS]  # Checked first.
+  for robot in chosen:
+    for path in model_export.export(robot, out, args.measure_speed):
       print(path)
 
 
@@ -477,6 +478,8 @@ def build_parser() -> argparse.ArgumentParser:
   models_commands = models.add_subparsers(dest="models_command", required=True)
   export_parser = models_commands.add_parser("export", help="write models/<name>/ for every robot")
   export_parser.add_argument("--out", default="models", help="output folder (default: models)")
+  export_parser.add_argument("--robots", nargs="+", metavar="ROBOT",
+                             help="export only these robots (default: every benchmark robot)")
   export_parser.add_argument("--measure-speed", action="store_true",
                              help="also measure simulation speed into speed.json")
   export_parser.set_defaults(run=_models_export)

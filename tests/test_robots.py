@@ -8,6 +8,7 @@ its raw structs rather than dm_control's Python step loop, for speed.
 Figures measured with mujoco 3.17.0 on CPU, quoted where each tolerance is chosen.
 """
 
+import math
 import re
 
 import mujoco
@@ -16,8 +17,11 @@ import pytest
 
 from softbench.robots import BENCHMARK_ROBOTS
 from softbench.robots import MAX_MODULES
+from softbench.robots import TENDON_FAMILIES
 from softbench.robots import make
+from softbench.robots import measure
 from softbench.robots import pneumatic
+from softbench.robots import tendon_family
 from softbench.robots.physics import SoftArmPhysics
 
 # Object kind (the MjModel accessor) and the MjModel attribute that counts them.
@@ -45,6 +49,10 @@ MIRROR_TOLERANCE = 1e-6
 # pneumatic arm, the slowest), while consecutive actuation levels are 7 degrees or more apart.
 BEND_SETTLE_S = 5.0
 BEND_LEVELS = (0.2, 0.4, 0.6, 0.8, 1.0)
+# Gravity off, module k fully actuated alone for 3 s (measure.gravity_free_tilts): the proximal
+# modules' tips turn by 0.0 deg on every tendon-local arm (exactly: no load reaches them), and by
+# 30.6 deg or more on every tendon-N arm (tendon-3, module 3: 30.6 and 61.2 deg).
+PROXIMAL_TILT_DEG = {"tendon": (10.0, math.inf), "tendon-local": (0.0, 1.0)}
 # tendon-1 and tendon-3 reach equilibrium (max |qvel| < 1e-13) in 3 s for every action below.
 BACKBONE_SETTLE_S = 4.0
 BACKBONE_TOLERANCE = 0.01  # Fraction of the arm length.
@@ -52,7 +60,7 @@ BACKBONE_TOLERANCE = 0.01  # Fraction of the arm length.
 
 def _expected_size(name: str) -> tuple[int, int]:
   """(num_modules, action_dim) that a registry name promises."""
-  if match := re.fullmatch(r"tendon-(\d+)", name):
+  if match := re.fullmatch(r"tendon(?:-local)?-(\d+)", name):
     return int(match.group(1)), 2 * int(match.group(1))
   if match := re.fullmatch(r"pneumatic-(\d+)", name):
     bellows = [int(digit) for digit in match.group(1)]
@@ -260,6 +268,34 @@ def test_bending_grows_with_actuation(robot_name):
         f"module {module} bend angles (deg) not increasing: {np.round(angles, 2).tolist()}")
 
 
+# 5b. Where a module's actuators act: within the module, or through the proximal ones too.
+
+
+def _multi_module_tendon_arms() -> list:
+  return [pytest.param(name, id=name) for name in BENCHMARK_ROBOTS
+          if tendon_family(name) and make(name).num_modules > 1]
+
+
+@pytest.mark.parametrize("robot_name", _multi_module_tendon_arms())
+def test_a_module_turns_the_proximal_ones_as_its_family_routes_cables(robot_name):
+  robot = make(robot_name)
+  low, high = PROXIMAL_TILT_DEG[tendon_family(robot_name).FAMILY]
+  for module in range(2, robot.num_modules + 1):
+    tilts = measure.gravity_free_tilts(robot, module)
+    proximal = tilts[:module - 1]
+    assert low <= proximal.min() and proximal.max() <= high, (
+        f"module {module} turns the tips by {np.round(tilts, 2).tolist()} deg")
+    assert tilts[module - 1] > 45.0, f"module {module}'s own tip turns {tilts[module - 1]:.1f} deg"
+
+
+def test_a_one_module_local_arm_is_the_one_module_arm():
+  # Module 1's cables start at the clamp in both families; only their hole names differ.
+  local, crossing = make("tendon-local-1"), make("tendon-1")
+  for action in _random_actions(local, 3, seed=4) + [np.ones(2)]:
+    np.testing.assert_array_equal(settle(local, action, 1.0).module_poses(),
+                                  settle(crossing, action, 1.0).module_poses())
+
+
 # 6. Bad input.
 
 
@@ -267,6 +303,11 @@ def test_bending_grows_with_actuation(robot_name):
     ("tendon-0", {}),
     ("tendon-x", {}),
     ("tendon-1000", {}),
+    ("tendon-local-0", {}),
+    ("tendon-local-x", {}),
+    (f"tendon-local-{MAX_MODULES + 1}", {}),
+    ("tendon-local-3", {"pass_through_offset": 0.002}),  # No cable crosses a proximal module.
+    ("tendon-3", {"FAMILY": "tendon-local"}),
     (f"tendon-{MAX_MODULES + 1}", {}),
     ("foo", {}),
     ("tendon-3", {"module_length": -0.05}),
@@ -307,9 +348,10 @@ def test_set_action_rejects_bad_actions(robot_name):
   physics.set_action(-np.ones(dim))
 
 
+@pytest.mark.parametrize("family", TENDON_FAMILIES)
 @pytest.mark.parametrize("num_modules", range(1, MAX_MODULES + 1))
-def test_every_tendon_arm_builds(num_modules):
-  robot = make(f"tendon-{num_modules}")
+def test_every_tendon_arm_builds(family, num_modules):
+  robot = make(f"{family}-{num_modules}")
   model = robot.compile()
   assert robot.num_modules == num_modules
   assert model.nu == model.ntendon == 4 * num_modules

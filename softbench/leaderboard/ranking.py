@@ -127,8 +127,9 @@ def _group_key(record: dict) -> tuple[str, str, str]:
 
 
 def robot_order(robot: str) -> tuple:
-  """Robots by family, then module count (tendon-2 before tendon-10)."""
-  family, _, size = robot.partition("-")
+  """Robots by family, then module count (tendon-2 before tendon-10, tendon-5 before
+  tendon-local-1)."""
+  family, _, size = robot.rpartition("-")
   return family, int(size) if size.isdigit() else 0, robot
 
 

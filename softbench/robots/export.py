@@ -6,6 +6,7 @@ depends on the machine, so it is measured only when asked (``--measure-speed``) 
 ``speed.json``; everything else is deterministic and regenerates byte for byte.
 """
 
+import dataclasses
 import json
 import pathlib
 import platform
@@ -69,6 +70,9 @@ def readme(robot: base.SoftArm, speed: dict | None) -> str:
       f"{model.nbody - 1} bodies, {model.nv} DOF, {model.ntendon} tendons, {model.nu} actuators.",
       "- Bend of module 1 at full actuation of module 1 alone "
       f"(after {measure.SETTLE_SECONDS:.0f} s): {bend:.1f} deg.",
+      "- Bend of each module relative to its base (the preceding module's tip) at full actuation "
+      f"of that module alone: {_degrees(measure.own_bend_angles(robot))} deg, module 1 first.",
+      *_coupling(robot),
       f"- Workspace of the end effector over {measure.WORKSPACE_SAMPLES} random actions, each held "
       f"one control period ({robot.control_timestep} s): "
       f"x {extent[0, 0]:.0f} to {extent[0, 1]:.0f} mm, "
@@ -95,10 +99,23 @@ def readme(robot: base.SoftArm, speed: dict | None) -> str:
   return "\n".join(lines) + "\n"
 
 
+def _degrees(angles) -> str:
+  return ", ".join(f"{angle:.1f}" for angle in angles)
+
+
+def _coupling(robot: base.SoftArm) -> list[str]:
+  """How far the last module's actuators turn the proximal modules, gravity off."""
+  if robot.num_modules == 1:
+    return []
+  tilts = measure.gravity_free_tilts(robot, robot.num_modules)
+  return [f"- Coupling, gravity off: full actuation of module {robot.num_modules} alone turns "
+          f"the module tips by {_degrees(tilts)} deg, module 1 first."]
+
+
 def spec_fields(robot: base.SoftArm):
   """(field, printable value) of every field of the robot's spec; ``faults`` only when there
   are some (exported models are healthy)."""
-  for field in robot.__dataclass_fields__:
+  for field in (entry.name for entry in dataclasses.fields(robot)):
     value = getattr(robot, field)
     if field == "faults":
       if value:

@@ -50,18 +50,51 @@ def full_bend_action(robot: base.SoftArm, module: int) -> np.ndarray:
   return action
 
 
+def tip_axes(robot: base.SoftArm, action: np.ndarray, seconds: float = SETTLE_SECONDS,
+             gravity: bool = True) -> tuple[np.ndarray, np.ndarray]:
+  """Every module's tip axis (modules, 3) at rest and after holding ``action`` for ``seconds``
+  from rest, with or without gravity."""
+  model = robot.compile()
+  if not gravity:
+    model.opt.gravity[:] = 0.0
+  data = mujoco.MjData(model)
+  mujoco.mj_kinematics(model, data)
+  sites = [model.site(chain.tip_site_name(k)).id for k in range(1, robot.num_modules + 1)]
+  rest = data.site_xmat[sites].reshape(-1, 3, 3)[:, :, 2].copy()
+  data.ctrl[:] = robot.action_to_ctrl(action)
+  mujoco.mj_step(model, data, nstep=int(round(seconds / model.opt.timestep)))
+  return rest, data.site_xmat[sites].reshape(-1, 3, 3)[:, :, 2].copy()
+
+
+def _angles(first: np.ndarray, second: np.ndarray) -> np.ndarray:
+  """Angles (deg) between unit vectors, row by row."""
+  return np.degrees(np.arccos(np.clip(np.sum(first * second, axis=-1), -1.0, 1.0)))
+
+
 def bend_angle(robot: base.SoftArm, action: np.ndarray, module: int = 1,
                seconds: float = SETTLE_SECONDS) -> float:
   """Angle (deg) between a module's tip axis at rest and after holding ``action``."""
-  model = robot.compile()
-  data = mujoco.MjData(model)
-  mujoco.mj_kinematics(model, data)
-  site = model.site(chain.tip_site_name(module)).id
-  rest_axis = data.site_xmat[site].reshape(3, 3)[:, 2].copy()
-  data.ctrl[:] = robot.action_to_ctrl(action)
-  mujoco.mj_step(model, data, nstep=int(round(seconds / model.opt.timestep)))
-  axis = data.site_xmat[site].reshape(3, 3)[:, 2]
-  return float(np.degrees(np.arccos(np.clip(axis @ rest_axis, -1.0, 1.0))))
+  rest, bent = tip_axes(robot, action, seconds)
+  return float(_angles(rest, bent)[module - 1])
+
+
+def own_bend_angles(robot: base.SoftArm, seconds: float = SETTLE_SECONDS) -> np.ndarray:
+  """Per module k, the angle (deg) between its tip axis and its base's (the preceding module's
+  tip axis, or the arm's axis at rest) after holding full actuation of module k alone."""
+  angles = []
+  for module in range(1, robot.num_modules + 1):
+    rest, bent = tip_axes(robot, full_bend_action(robot, module), seconds)
+    base_axis = rest[0] if module == 1 else bent[module - 2]
+    angles.append(float(_angles(base_axis, bent[module - 1])))
+  return np.array(angles)
+
+
+def gravity_free_tilts(robot: base.SoftArm, module: int,
+                       seconds: float = SETTLE_SECONDS) -> np.ndarray:
+  """Angle (deg) of every module's tip axis from rest after holding full actuation of ``module``
+  alone, gravity off: how far one module's actuators turn the others."""
+  rest, bent = tip_axes(robot, full_bend_action(robot, module), seconds, gravity=False)
+  return _angles(rest, bent)
 
 
 def settling_time(robot: base.SoftArm, seconds: float = SETTLE_SECONDS) -> float:

@@ -1,4 +1,4 @@
-"""``tendon-N``: a modular tendon-driven soft arm (SPEC 2.1).
+"""``tendon-N``: a modular tendon-driven soft arm whose cables cross the proximal modules (SPEC 2.1).
 
 N modules of 50 mm hang from a fixed base under gravity. The backbone is a silicone rod cut into
 rigid segments whose elasticity comes from MuJoCo's ``mujoco.elasticity.cable`` plugin (the
@@ -11,11 +11,17 @@ a distal module also bends the proximal ones.
 Action: two values per module in [-1, 1]. Value a of axis x pulls the +x cable with tension
 max(0, a)·Tmax and the -x cable with max(0, -a)·Tmax (the paper's antagonistic convention);
 likewise for y.
+
+``CableDrivenArm`` is what every tendon family shares (backbone, material, cables, actuation);
+a family decides only where each cable runs (``cable_route``). ``tendon_local`` holds the
+module-local family, ``tendon-local-N``.
 """
 
+import abc
 import dataclasses
 import math
 import re
+from typing import ClassVar
 
 import mujoco
 import numpy as np
@@ -25,19 +31,18 @@ from softbench.robots import chain
 from softbench.robots import faults as fault_model
 
 MODULE_LENGTH = 0.05  # (m) Paper: "Each module has a length of 50 mm".
-MAX_MODULES = 10  # Largest N that builds; tendon-1 .. tendon-5 are the benchmark configurations.
+MAX_MODULES = 10  # Largest N that builds; N = 1 .. 5 are the benchmark configurations.
 BACKBONES = ("cable", "joints")
 # Cables, as (name, angle around the arm in degrees, action axis, sign of the action that pulls it).
 _CABLES = (("xpos", 0.0, 0, +1), ("ypos", 90.0, 1, +1), ("xneg", 180.0, 0, -1),
            ("yneg", 270.0, 1, -1))
 _MODULE_RGBA = ((0.90, 0.35, 0.25, 1), (0.95, 0.70, 0.20, 1), (0.35, 0.70, 0.35, 1),
                 (0.25, 0.55, 0.85, 1), (0.55, 0.40, 0.80, 1))
-_NAME_PATTERN = re.compile(r"^tendon-(\d+)$")
 
 
 @dataclasses.dataclass(frozen=True)
-class TendonArm(base.SoftArm):
-  """Frozen spec of a tendon-driven arm; every field has SI units.
+class CableDrivenArm(base.SoftArm):
+  """Frozen spec of a tendon-driven arm of any family; every field has SI units.
 
   Attributes:
     num_modules: Number of 50 mm modules, 1 to 10.
@@ -53,9 +58,6 @@ class TendonArm(base.SoftArm):
     poisson_ratio: Poisson's ratio; the torsion modulus is E / (2 (1 + nu)).
     density: Backbone density (kg/m³), silicone rubber.
     cable_offset: Distance of a cable from the backbone axis inside its own module (m).
-    pass_through_offset: Distance from the axis of the holes through which a cable crosses the
-      proximal modules on its way to its own (m); closer to the axis than ``cable_offset`` so
-      that a distal cable loads proximal modules with a third of the moment, not all of it.
     max_tension: Tmax, the cable tension at action ±1 (N).
     damping: Rotational damping of every segment joint (N·m·s/rad).
     medium_viscosity: Viscosity of the surrounding medium (Pa·s), MuJoCo's Stokes drag on every
@@ -79,7 +81,6 @@ class TendonArm(base.SoftArm):
   poisson_ratio: float = 0.5
   density: float = 1100.0
   cable_offset: float = 0.006
-  pass_through_offset: float = 0.002
   max_tension: float = 2.58  # Bends tendon-1 by 89.8 deg (bisection on measure.bend_angle).
   damping: float = 2.0e-3
   medium_viscosity: float = 0.1
@@ -89,17 +90,21 @@ class TendonArm(base.SoftArm):
   control_period: float = 1.0
   faults: tuple[fault_model.Fault, ...] = ()
 
+  FAMILY: ClassVar[str]  # Registry names are FAMILY-N.
+  _POSITIVE_FIELDS: ClassVar[tuple[str, ...]] = ()  # A family's own fields that must be > 0.
+
   def __post_init__(self):
     if (isinstance(self.num_modules, bool) or not isinstance(self.num_modules, int)
         or not 1 <= self.num_modules <= MAX_MODULES):
-      raise ValueError(f"tendon arms have 1 to {MAX_MODULES} modules, got {self.num_modules!r}")
+      raise ValueError(f"{self.FAMILY} arms have 1 to {MAX_MODULES} modules, "
+                       f"got {self.num_modules!r}")
     if not isinstance(self.segments_per_module, int) or self.segments_per_module < 1:
       raise ValueError(f"segments_per_module must be a positive integer, "
                        f"got {self.segments_per_module!r}")
     if not 0 < self.hole_inset < 0.5:
       raise ValueError(f"hole_inset must lie strictly between 0 and 0.5, got {self.hole_inset!r}")
-    for field in ("radius", "youngs_modulus", "density", "cable_offset",
-                  "pass_through_offset", "max_tension", "timestep", "control_period"):
+    for field in ("radius", "youngs_modulus", "density", "cable_offset", "max_tension",
+                  "timestep", "control_period", *self._POSITIVE_FIELDS):
       base.check_positive(field, getattr(self, field))
     base.check_module_length(self.module_length)
     for field in ("damping", "medium_viscosity", "armature"):
@@ -112,17 +117,17 @@ class TendonArm(base.SoftArm):
     fault_model.check(self, self.faults)
 
   @classmethod
-  def from_name(cls, name: str, **overrides) -> "TendonArm":
+  def from_name(cls, name: str, **overrides) -> "CableDrivenArm":
     """``TendonArm.from_name('tendon-3')``; raises ValueError for a malformed name."""
-    match = _NAME_PATTERN.match(name)
+    match = re.fullmatch(rf"{re.escape(cls.FAMILY)}-(\d+)", name)
     if not match:
-      raise ValueError(f"malformed tendon arm name {name!r}; expected tendon-N with N from 1 to "
-                       f"{MAX_MODULES}")
+      raise ValueError(f"malformed {cls.FAMILY} arm name {name!r}; expected {cls.FAMILY}-N with N "
+                       f"from 1 to {MAX_MODULES}")
     return cls(num_modules=int(match.group(1)), **overrides)
 
   @property
   def name(self) -> str:
-    return f"tendon-{self.num_modules}"
+    return f"{self.FAMILY}-{self.num_modules}"
 
   @property
   def module_lengths(self) -> tuple[float, ...]:
@@ -200,39 +205,66 @@ class TendonArm(base.SoftArm):
     rod = chain.add_chain(base_body, geometry, joints, _MODULE_RGBA, plugin)
     self._add_cables(spec, rod)
 
-  def _add_cables(self, spec: mujoco.MjSpec, rod: chain.Chain) -> None:
-    """Routes four cables per module along the rod to the module's tip, where each is anchored,
-    and gives each cable a pulling motor.
+  @abc.abstractmethod
+  def cable_route(self, rod: chain.Chain, module: int) -> list[tuple[str, float, float]]:
+    """Where each cable of ``module`` (1-based) is held on its way from the base of the arm or
+    of its module to the module's tip, before its anchor: (site label, arc length (m), distance
+    from the axis (m)) per hole, base first. The label, completed with the cable's name, names
+    the site; cables of different modules that share a label share the hole."""
 
-    A cable runs in a channel, held near both ends of every segment (``Chain.channel_holes``).
-    Inside its own module a cable runs at ``cable_offset``; through proximal modules at
-    ``pass_through_offset``.
-    """
-    geometry = rod.geometry
+  def _add_cables(self, spec: mujoco.MjSpec, rod: chain.Chain) -> None:
+    """Routes four cables per module along ``cable_route`` to the module's tip, where each is
+    anchored at ``cable_offset``, and gives each cable a pulling motor."""
     angles = [angle for _, angle, _, _ in _CABLES]
-    rings = {"outer": chain.ring_offsets(self.cable_offset, angles),
-             "inner": chain.ring_offsets(self.pass_through_offset, angles)}
     added = set()  # Holes are shared by every cable that passes them.
     for module in range(1, self.num_modules + 1):
-      start, tip = geometry.module_start(module), geometry.module_start(module + 1)
+      tip = rod.geometry.module_start(module + 1)
       rgba = chain.module_rgba(_MODULE_RGBA, module)
+      route = self.cable_route(rod, module)
       for cable, (cable_name, *_) in enumerate(_CABLES):
         tendon = spec.add_tendon(name=f"module{module}_cable_{cable_name}", width=0.0005,
                                  rgba=rgba)
-        for prefix, arc_length in rod.channel_holes(self.hole_inset, end=tip):
-          ring = "outer" if arc_length >= start or module == 1 else "inner"
-          site = f"{prefix}_{ring}_hole_{cable_name}"
+        for label, arc_length, offset in route:
+          site = f"{label}_{cable_name}"
           if site not in added:
             added.add(site)
-            rod.add_site(site, arc_length, rings[ring][cable], size=(0.0006, 0, 0),
-                         rgba=(0.2, 0.2, 0.2, 1))
+            rod.add_site(site, arc_length, chain.ring_offsets(offset, angles)[cable],
+                         size=(0.0006, 0, 0), rgba=(0.2, 0.2, 0.2, 1))
           tendon.wrap_site(site)
         anchor = f"module{module}_anchor_{cable_name}"
-        rod.add_site(anchor, tip, rings["outer"][cable], size=(0.0009, 0, 0),
-                     rgba=(0.1, 0.1, 0.1, 1))
+        rod.add_site(anchor, tip, chain.ring_offsets(self.cable_offset, angles)[cable],
+                     size=(0.0009, 0, 0), rgba=(0.1, 0.1, 0.1, 1))
         tendon.wrap_site(anchor)
         spec.add_actuator(
             name=f"module{module}_cable_{cable_name}",
             trntype=mujoco.mjtTrn.mjTRN_TENDON, target=tendon.name,
             gear=(-1, 0, 0, 0, 0, 0),  # Cables pull: positive control shortens the tendon.
             ctrllimited=mujoco.mjtLimited.mjLIMITED_TRUE, ctrlrange=(0, self.max_tension))
+
+
+@dataclasses.dataclass(frozen=True)
+class TendonArm(CableDrivenArm):
+  """``tendon-N``: every cable runs from the arm's base, through the proximal modules, to its
+  module's tip (the fields of ``CableDrivenArm``, and one more).
+
+  Attributes:
+    pass_through_offset: Distance from the axis of the holes through which a cable crosses the
+      proximal modules on its way to its own (m); closer to the axis than ``cable_offset`` so
+      that a distal cable loads proximal modules with a third of the moment, not all of it.
+  """
+
+  pass_through_offset: float = 0.002
+
+  FAMILY: ClassVar[str] = "tendon"
+  _POSITIVE_FIELDS: ClassVar[tuple[str, ...]] = ("pass_through_offset",)
+
+  def cable_route(self, rod: chain.Chain, module: int) -> list[tuple[str, float, float]]:
+    """Through every hole of the channel from the base: at ``cable_offset`` inside the cable's
+    own module (and all of module 1), at ``pass_through_offset`` in the proximal modules."""
+    start, tip = rod.geometry.module_start(module), rod.geometry.module_start(module + 1)
+    route = []
+    for prefix, arc_length in rod.channel_holes(self.hole_inset, end=tip):
+      own = arc_length >= start or module == 1
+      route.append((f"{prefix}_{'outer' if own else 'inner'}_hole", arc_length,
+                    self.cable_offset if own else self.pass_through_offset))
+    return route
