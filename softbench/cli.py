@@ -159,13 +159,16 @@ def _run_protocol(args: argparse.Namespace) -> None:
     raise ValueError(f"--protocol {args.protocol} fixes its robots, tasks and loops; drop "
                      f"{', '.join(given) or '--eval'}")
   profile = profiles.get(args.profile)
-  record = continual.execute(profile, args.seeds, workers=args.workers, keep_seeds=True)
+  family = args.family or continual.DEFAULT_FAMILY
+  continual.protocol(family)  # Checked before anything runs.
+  record = continual.execute(profile, args.seeds, workers=args.workers, keep_seeds=True,
+                             family=family)
   print(continual.table(record))
   path = continual.record_path(record, pathlib.Path(args.results))
   run_module.write_record(record, path)
   print(f"result record: {path}")
   # Only now: a failed write leaves a run that resumes.
-  episode_snapshots.discard_folder(continual.finished_seeds_folder(profile))
+  episode_snapshots.discard_folder(continual.finished_seeds_folder(profile, family))
   heat_map = plots.forgetting_matrix(continual.mean_forgetting(record), record["robots"],
                                      path.with_name(f"{path.stem}-forgetting.png"))
   print(f"plot: {heat_map}")
@@ -219,6 +222,8 @@ def _run(args: argparse.Namespace) -> None:
     dataset.check_count("workers", args.workers)
   if args.protocol is not None:
     return _run_protocol(args)
+  if args.family is not None:
+    raise ValueError("--family goes with --protocol exp1s; a task's robot is --robot")
   if args.task is None:
     raise ValueError("softbench run needs --task TASK (or --protocol exp1s)")
   settings = run_module.settings(args.task, args.agent, args.robot, args.seeds, args.profile,
@@ -398,6 +403,10 @@ def build_parser() -> argparse.ArgumentParser:
   run_parser.add_argument("--protocol", help=f"{continual.PROTOCOL}: SMPL learns tendon-1 .. "
                                              f"tendon-5 in sequence; prints the paper's Exp1S "
                                              f"table and the forgetting matrix")
+  run_parser.add_argument("--family", help=f"with --protocol {continual.PROTOCOL}: the tendon "
+                                           f"family whose arms 1 .. 5 SMPL learns, one of "
+                                           f"{', '.join(robots.TENDON_FAMILIES)} (default "
+                                           f"{continual.DEFAULT_FAMILY})")
   run_parser.add_argument("--agent", required=True, help=f"one of {', '.join(agents.AGENTS)}")
   run_parser.add_argument("--robot", help="default: the task's robot in the paper (tendon-3; "
                                           "pneumatic-433 for reach)")

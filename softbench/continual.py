@@ -1,5 +1,7 @@
 """Exp1S in physics: SMPL learns tendon-1 .. tendon-5 in sequence, one column per configuration,
-and every configuration is scored on its end effector, closed and open loop, in MuJoCo.
+and every configuration is scored on its end effector, closed and open loop, in MuJoCo. The
+configurations are arms of one tendon family (``tendon`` by default; ``tendon-local`` is the
+paper's module-local plant): ``family-1`` .. ``family-5``.
 
 Training (cached per seed, like the agents' checkpoints): configuration N's babbling dataset (data
 seed 0, the profile's sample count) in the end-effector view, a frozen forward model, then a new
@@ -32,6 +34,7 @@ from softbench import evaluation
 from softbench import metrics
 from softbench import profiles
 from softbench import protocols
+from softbench import robots
 from softbench import suite
 from softbench.agents import hyperparameters
 from softbench.agents import learned
@@ -42,6 +45,16 @@ TASKS = ("babbling", "circle", "rectangle", "spiral")  # The paper's Exp1S table
 LOOPS = {"closed": "physics", "open": "open-loop"}  # Table label -> the agent's error source.
 FORGETTING_TASK = "spiral"
 METRICS = ("position_mm", "orientation_deg", "normalised_tip_percent")
+DEFAULT_FAMILY = "tendon"
+
+
+def protocol(family: str = DEFAULT_FAMILY) -> protocols.Protocol:
+  """Exp1S on the arms of tendon family ``family``; raises a one-line ValueError for an unknown
+  family."""
+  if family not in robots.TENDON_FAMILIES:
+    raise ValueError(f"unknown tendon family {family!r}; choose one of "
+                     f"{', '.join(robots.TENDON_FAMILIES)}")
+  return protocols.get(PROTOCOL).on_family(family)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -77,7 +90,8 @@ class Exp1sModel:
   forgetting_action_mse: np.ndarray
 
   def agent(self, configuration: int, seed: int) -> learned.LearnedAgent:
-    """The controller of configuration ``configuration`` (1 = tendon-1): its column alone."""
+    """The controller of configuration ``configuration`` (1 = the one-module arm): its column
+    alone."""
     index = configuration - 1
     column = progressive.ProgressiveColumn(self.network, index)
     return learned.LearnedAgent(self.arms[index], seed, column, [self.controllers[index]])
@@ -87,20 +101,23 @@ def _config(seed: int, profile: profiles.Profile, arms: list) -> Exp1sConfig:
   return Exp1sConfig(tuple(arm.name for arm in arms),
                      tuple(hashlib.sha256(arm.to_xml().encode()).hexdigest() for arm in arms),
                      profile.samples, seed, profile.max_epochs, profile.patience, profile.compile,
-                     tuple(sorted(_params().items())))
+                     tuple(sorted(_params(arms[-1].name).items())))
 
 
-def _params() -> dict:
-  """SMPL's hyperparameters (the agent's, tuned on tendon-3; the columns keep the SPEC's size)."""
-  return hyperparameters.values("smpl", protocols.get(PROTOCOL).robot_names[-1])
+def _params(last_robot: str) -> dict:
+  """SMPL's hyperparameters for the sequence ending with ``last_robot`` (the agent's, tuned on
+  tendon-3 unless that robot has its own; the columns keep the SPEC's size)."""
+  return hyperparameters.values("smpl", last_robot)
 
 
-def _train(seed: int, profile: profiles.Profile, show: bool):
+def _train(seed: int, profile: profiles.Profile, show: bool, family: str):
   """Column by column over the configurations; returns network, forwards, normalisations, run."""
-  forward_config, inverse_config = learned.training_configs(seed, profile, _params())
+  sequence = protocol(family)
+  forward_config, inverse_config = learned.training_configs(seed, profile,
+                                                            _params(sequence.robot_names[-1]))
   progress_bars = lambda label: learned.progress_bar(f"{label} ({PROTOCOL} seed {seed})",
                                                      profile.max_epochs, show)
-  result = protocols.run(protocols.get(PROTOCOL), profile.samples, learned.DATA_SEED,
+  result = protocols.run(sequence, profile.samples, learned.DATA_SEED,
                          forward_config, inverse_config, training.default_device(), show,
                          progress_bars)
   result.network.requires_grad_(False)
@@ -113,20 +130,22 @@ def _matrices(outcome: smpl_protocol.ProgressiveRun) -> dict[str, np.ndarray]:
           for metric in ("pose_mse", "action_mse")}
 
 
-def build(seed: int, profile: profiles.Profile, show_progress: bool = False) -> Exp1sModel:
+def build(seed: int, profile: profiles.Profile, show_progress: bool = False,
+          family: str = DEFAULT_FAMILY) -> Exp1sModel:
   """The Exp1S network of ``seed``: from the checkpoint cache, or trained now and cached."""
-  views_of = protocols.get(PROTOCOL).column_views()
+  views_of = protocol(family).column_views()
   arms = [arm for arm, _ in views_of]
   views = [view for _, view in views_of]
   config = _config(seed, profile, arms)
 
   def train() -> learned.TrainedModels:
-    network, forwards, normalisations, outcome = _train(seed, profile, show_progress)
+    network, forwards, normalisations, outcome = _train(seed, profile, show_progress, family)
     return learned.TrainedModels(network, forwards, normalisations, _matrices(outcome))
 
   models = learned.load_or_train(learned.checkpoint_file(config), config,
                                  [arm.name for arm in arms],
-                                 lambda: learned.untrained(views, True, None, _params()), train)
+                                 lambda: learned.untrained(views, True, None,
+                                                           _params(arms[-1].name)), train)
   network, forwards, normalisations = models.inverse, models.forwards, models.normalisations
   matrices = models.arrays
   network.eval()
@@ -159,36 +178,38 @@ def _end_effector_scores(episode: evaluation.Episode, length: float) -> dict:
   return {name: getattr(score, name)[-1].mean for name in METRICS if getattr(score, name)}
 
 
-def finished_seeds_folder(profile: profiles.Profile) -> pathlib.Path:
+def finished_seeds_folder(profile: profiles.Profile,
+                          family: str = DEFAULT_FAMILY) -> pathlib.Path:
   """Where the scores of the seeds (and, under ``EPISODES_FOLDER``, of the episodes) that an
   interrupted run finished are kept (``episode_snapshots``: keyed by the settings and the code)."""
   return episode_snapshots.keyed_folder(
-      f"smpl-{PROTOCOL}", (dataclasses.asdict(profile), protocols.get(PROTOCOL).robot_names))
+      f"smpl-{PROTOCOL}", (dataclasses.asdict(profile), protocol(family).robot_names))
 
 
 EPISODES_FOLDER = "episodes"  # Inside finished_seeds_folder: the finished episodes of a seed.
 
 
-def run_seed(seed: int, profile: profiles.Profile, show_progress: bool = False) -> dict:
+def run_seed(seed: int, profile: profiles.Profile, family: str = DEFAULT_FAMILY,
+             show_progress: bool = False) -> dict:
   """``score_seed``, or the scores an interrupted run of the same settings and code kept: the
   seed's, or those of each episode it had finished."""
-  folder = finished_seeds_folder(profile)
+  folder = finished_seeds_folder(profile, family)
   path, subject = folder / f"seed{seed}.json", f"seed {seed}"
   scores = episode_snapshots.load_scores(path, subject)
   if scores is None:
     episodes = folder / EPISODES_FOLDER
     kept = len(list(episodes.glob(f"seed{seed}-*.json")))
     if kept and show_progress:
-      total = len(protocols.get(PROTOCOL).robot_names) * len(LOOPS) * len(TASKS)
+      total = len(protocol(family).robot_names) * len(LOOPS) * len(TASKS)
       print(f"resuming seed {seed}: {kept} of its {total} episodes finished before the run was "
             "interrupted", file=sys.stderr)
-    scores = score_seed(seed, profile, show_progress, episodes)
+    scores = score_seed(seed, profile, show_progress, episodes, family)
     episode_snapshots.save_scores(path, scores, subject)
   return scores
 
 
 def score_seed(seed: int, profile: profiles.Profile, show_progress: bool,
-               kept_episodes: pathlib.Path) -> dict:
+               kept_episodes: pathlib.Path, family: str = DEFAULT_FAMILY) -> dict:
   """Trains (or loads) seed ``seed``'s network and scores every configuration, task and loop.
 
   Each episode's scores are kept in ``kept_episodes`` as it ends, and an episode whose scores
@@ -198,7 +219,7 @@ def score_seed(seed: int, profile: profiles.Profile, show_progress: bool,
   Returns {"seed", "scores": {loop: {task: [per configuration {metric: value}]}},
   "forgetting_model_pose_mse", "forgetting_tip_percent"} (matrices as nested lists, NaN -> None).
   """
-  model = build(seed, profile, show_progress)
+  model = build(seed, profile, show_progress, family)
   check_no_forgetting(model.forgetting_pose_mse)
   check_no_forgetting(model.forgetting_action_mse)
   scores = {loop: {task: [] for task in TASKS} for loop in LOOPS}
@@ -231,28 +252,30 @@ RECORD_VERSION = 2  # 2: sealed with an integrity hash (softbench.leaderboard.ex
 
 
 def execute(profile: profiles.Profile, seeds: int | None = None, show_progress: bool = True,
-            workers: int | None = None, keep_seeds: bool = False) -> dict:
+            workers: int | None = None, keep_seeds: bool = False,
+            family: str = DEFAULT_FAMILY) -> dict:
   """Every seed (in parallel processes), then the result record with full provenance.
 
   Each finished seed's scores are kept until the end, so that an interrupted run resumes with
   the seeds still to run; unless ``keep_seeds``, they are discarded at the end (else the caller
-  discards them, ``episode_snapshots.discard_folder(finished_seeds_folder(profile))``, once the
-  record is safely written)."""
+  discards them, ``episode_snapshots.discard_folder(finished_seeds_folder(profile, family))``,
+  once the record is safely written)."""
   from softbench import run  # run imports the agents; imported here to keep this module light.
   started, origin = time.perf_counter(), run.provenance()
   seeds = profile.seeds if seeds is None else seeds
   dataset.check_count("seeds", seeds)
-  for arm, _ in protocols.get(PROTOCOL).column_views():  # Every core collects, before the seeds.
+  sequence = protocol(family)
+  for arm, _ in sequence.column_views():  # Every core collects, before the seeds.
     data.collect(arm, samples=profile.samples, seed=learned.DATA_SEED, progress=show_progress)
   if show_progress:
-    episode_snapshots.report_resuming(finished_seeds_folder(profile), seeds)
-  per_seed = run.over_seeds(run_seed, seeds, (profile,), f"smpl {PROTOCOL}", show_progress,
-                            workers)
+    episode_snapshots.report_resuming(finished_seeds_folder(profile, family), seeds)
+  per_seed = run.over_seeds(run_seed, seeds, (profile, family), f"smpl {PROTOCOL}",
+                            show_progress, workers)
   if not keep_seeds:
-    episode_snapshots.discard_folder(finished_seeds_folder(profile))
+    episode_snapshots.discard_folder(finished_seeds_folder(profile, family))
   return {"format": RECORD_FORMAT, "version": RECORD_VERSION, **origin,
           "protocol": PROTOCOL, "agent": "smpl",
-          "robots": list(protocols.get(PROTOCOL).robot_names),
+          "robots": list(sequence.robot_names),
           "tasks": list(TASKS), "profile": profile.name,
           "profile_settings": dataclasses.asdict(profile), "seeds": seeds, "per_seed": per_seed,
           "wall_time_s": round(time.perf_counter() - started, 3)}
@@ -303,6 +326,16 @@ def table(record: dict) -> str:
   return "\n".join(lines)
 
 
+def family_of(record: dict) -> str:
+  """The tendon family of an Exp1S record's configurations."""
+  return robots.tendon_family(record["robots"][0]).FAMILY
+
+
 def record_path(record: dict, results: pathlib.Path) -> pathlib.Path:
+  """``smpl-exp1s-PROFILE-DATE.json`` on the default family, ``smpl-exp1s-FAMILY-PROFILE-DATE``
+  on another."""
   from softbench import run
-  return results / f"smpl-{record['protocol']}-{record['profile']}-{run.date_stamp(record)}.json"
+  family = family_of(record)
+  name = "-".join([f"smpl-{record['protocol']}", *([family] if family != DEFAULT_FAMILY else []),
+                   record["profile"], run.date_stamp(record)])
+  return results / f"{name}.json"

@@ -38,6 +38,15 @@ class Protocol:
   per_module: bool
   description: str
 
+  def on_family(self, family: str) -> "Protocol":
+    """The same protocol on the arms of tendon family ``family`` with the same module counts
+    (``exp1s`` on tendon-local-1 .. tendon-local-5)."""
+    names = tuple(f"{family}-{robots.make(name).num_modules}" for name in self.robot_names)
+    if names == self.robot_names:
+      return self
+    return dataclasses.replace(self, robot_names=names,
+                               description=f"{self.description}, on the {family} family")
+
   def column_views(self) -> list[tuple[robots.SoftArm, data.View]]:
     """The robot and data view of each column, in training order."""
     arms = [robots.make(name) for name in self.robot_names]

@@ -11,29 +11,33 @@ from softbench import continual
 from softbench import data
 from softbench import episode_snapshots
 from softbench import profiles
+from softbench import robots
 from softbench.agents import learned
 from softbench.leaderboard import records
 
 
-def test_exp1s_end_to_end(two_stages, tmp_path, capsys):
+@pytest.mark.parametrize("family", robots.TENDON_FAMILIES)
+def test_exp1s_end_to_end(family, two_stages, tmp_path, capsys):
   results = tmp_path / "results"
   argv = ["run", "--protocol", "exp1s", "--agent", "smpl", "--profile", "tiny", "--seeds", "1",
-          "--results", str(results)]
+          "--results", str(results), "--family", family]
+  stages = [f"{family}-{robots.make(name).num_modules}" for name in two_stages]
   assert cli.main(argv) == 0
   out = capsys.readouterr().out
   for heading in ("closed loop, position (mm)", "open loop, position (mm)",
                   "closed loop, normalised tip error (%)", "forgetting matrix"):
     assert heading in out
-  (path,) = results.glob("smpl-exp1s-tiny-*.json")
+  named = "" if family == continual.DEFAULT_FAMILY else f"{family}-"
+  (path,) = results.glob(f"smpl-exp1s-{named}tiny-*.json")
   assert path.with_name(f"{path.stem}-forgetting.png").stat().st_size > 0
   record = records.read(path)  # Checked: schema, integrity hash, consistency.
   assert record == json.loads(path.read_text()) and record["version"] == continual.RECORD_VERSION
-  assert record["robots"] == list(two_stages) and record["seeds"] == 1
+  assert record["robots"] == stages and record["seeds"] == 1
   (seed,) = record["per_seed"]
   for loop in continual.LOOPS:
     for task in continual.TASKS:
       entries = seed["scores"][loop][task]
-      assert len(entries) == len(two_stages)
+      assert len(entries) == len(stages)
       assert all(np.isfinite(entry[name]) for entry in entries for name in continual.METRICS)
   matrix = seed["forgetting_tip_percent"]
   assert matrix[0][1] is None and matrix[1][0] == matrix[0][0]
@@ -41,7 +45,7 @@ def test_exp1s_end_to_end(two_stages, tmp_path, capsys):
   assert matrix[1] == closed_spiral
   model_level = seed["forgetting_model_pose_mse"]
   assert model_level[1][0] == model_level[0][0] and model_level[0][1] is None
-  assert not continual.finished_seeds_folder(profiles.get("tiny")).exists()  # Once written.
+  assert not continual.finished_seeds_folder(profiles.get("tiny"), family).exists()
   # The second run reuses the cached network and gives the same scores.
   again = tmp_path / "again.json"
   assert cli.main([*argv, "--json", str(again)]) == 0
@@ -74,6 +78,8 @@ def test_detected_forgetting_is_one_line_and_a_failure(two_stages, monkeypatch, 
     (["--agent", "lstm"], "takes --agent smpl"),
     (["--agent", "smpl", "--task", "spiral"], "drop --task"),
     (["--agent", "smpl", "--eval", "model"], "drop --eval"),
+    (["--agent", "smpl", "--family", "tendon-loc"], "unknown tendon family 'tendon-loc'"),
+    (["--agent", "smpl", "--family", "pneumatic"], "unknown tendon family 'pneumatic'"),
 ])
 def test_exp1s_refuses_bad_input_with_one_line(extra, message, capsys, tmp_path):
   argv = ["run", "--protocol", "exp1s", *extra, "--results", str(tmp_path)]
@@ -85,8 +91,11 @@ def test_exp1s_refuses_bad_input_with_one_line(extra, message, capsys, tmp_path)
 def test_unknown_protocol_and_missing_task(capsys):
   assert cli.main(["run", "--protocol", "exp9", "--agent", "smpl"]) == cli.EXIT_USAGE
   assert cli.main(["run", "--agent", "smpl"]) == cli.EXIT_USAGE
+  assert cli.main(["run", "--task", "spiral", "--agent", "smpl", "--family", "tendon-local"]) == (
+      cli.EXIT_USAGE)
   lines = capsys.readouterr().err.strip().splitlines()
   assert "unknown protocol" in lines[0] and "needs --task" in lines[1]
+  assert "--family goes with --protocol exp1s" in lines[2]
 
 
 @pytest.mark.parametrize("extra", [["--video", "x.mp4"], ["--fault", "1:0:0.5"], ["--adaptive"]])
@@ -116,11 +125,11 @@ def test_a_damaged_cached_network_is_trained_again(two_stages, tmp_path,
 def test_an_interrupted_exp1s_resumes_from_its_finished_seeds(two_stages, monkeypatch):
   tiny, scored, score_seed = profiles.get("tiny"), [], continual.score_seed
 
-  def counting(seed, profile, show_progress, kept_episodes):
+  def counting(seed, profile, show_progress, kept_episodes, family):
     scored.append(seed)
     if seed == 1 and len(scored) == 2:  # The first run stops as seed 1 starts.
       raise KeyboardInterrupt
-    return score_seed(seed, profile, show_progress, kept_episodes)
+    return score_seed(seed, profile, show_progress, kept_episodes, family)
 
   monkeypatch.setattr(continual, "score_seed", counting)
   with pytest.raises(KeyboardInterrupt):

@@ -7,6 +7,7 @@ import subprocess
 import sys
 
 import mujoco
+import numpy as np
 import pytest
 
 import softbench
@@ -14,6 +15,7 @@ from softbench import cli
 from softbench import robots
 from softbench import suite
 from softbench.robots import export
+from softbench.robots.physics import SoftArmPhysics
 
 MODELS = pathlib.Path(__file__).resolve().parents[1] / "models"
 
@@ -47,6 +49,24 @@ def test_exported_scene_compiles(name):
   assert model.geom("floor").id >= 0
 
 
+@pytest.mark.parametrize("name", [name for name in robots.BENCHMARK_ROBOTS
+                                  if name.startswith("tendon-local-")
+                                  and robots.make(name).num_modules >= 3])
+def test_exported_local_arm_bends_only_the_pulled_module(name):
+  # Gravity off, one cable of module 3 pulled at Tmax for 3 s, on the exported scene as a user
+  # loads it: module 1's tip turns 0.0 deg, module 3's 91.2 deg (tendon-3: 30.6 and 152.4 deg).
+  physics = SoftArmPhysics.from_xml_path(str(MODELS / name / "scene.xml"))
+  physics.model.opt.gravity[:] = 0.0
+  rest = physics.module_poses()[:, 3:]
+  action = np.zeros(physics.action_dim)
+  action[4] = 1.0  # Module 3's x axis: its +x cable at Tmax.
+  physics.set_action(action)
+  physics.step(int(round(3.0 / physics.model.opt.timestep)))
+  axes = physics.module_poses()[:, 3:]
+  turned = np.degrees(np.arccos(np.clip(np.sum(axes * rest, axis=1), -1.0, 1.0)))
+  assert turned[0] <= 1.0 and turned[2] >= 45.0, turned
+
+
 def test_cli_lists_every_benchmark_robot(capsys):
   assert cli.main(["robots"]) == 0
   rows = capsys.readouterr().out.splitlines()[1:]
@@ -61,6 +81,7 @@ def test_cli_describes_any_valid_tendon_arm(capsys):
 
 @pytest.mark.parametrize("argv", [
     ["robots", "tendon-0"], ["robots", "tendon-x"], ["robots", "tendon-1000"],
+    ["robots", "tendon-local-0"], ["robots", "tendon-local-x"], ["robots", "tendon-local-"],
     ["robots", "unicorn"], ["robots", "tendon-3", "--module-length", "-0.05"],
 ])
 def test_cli_refuses_bad_input_with_one_line_and_exit_code_2(argv, capsys):
@@ -71,6 +92,14 @@ def test_cli_refuses_bad_input_with_one_line_and_exit_code_2(argv, capsys):
   assert len(lines) == 1 and lines[0].startswith("softbench: error: ")
   with pytest.raises(ValueError, match=lines[0].removeprefix("softbench: error: ")[:20]):
     robots.make(argv[1], **({"module_length": -0.05} if len(argv) > 2 else {}))
+
+
+def test_cli_export_refuses_a_bad_robot_before_writing(tmp_path, capsys):
+  argv = ["models", "export", "--out", str(tmp_path), "--robots", "tendon-local-1", "tendon-local-0"]
+  assert cli.main(argv) == cli.EXIT_USAGE
+  assert capsys.readouterr().err.strip() == (
+      "softbench: error: tendon-local arms have 1 to 10 modules, got 0")
+  assert not any(tmp_path.iterdir())
 
 
 @pytest.mark.parametrize("length", ["80", "1e-6", "1e9"])

@@ -63,7 +63,7 @@ def main() -> None:
   forward = model.controllers[stage].forward.requires_grad_(False)
   task = smpl_protocol.ColumnTask(windows.train, windows.validation, windows.test, forward)
   trained = model.network.state_dict()
-  _, tuned = learned.training_configs(args.seed, profile, continual._params())
+  _, tuned = learned.training_configs(args.seed, profile, continual._params(model.arms[-1].name))
 
   for learning_rate, pose_loss_weight in args.settings:
     network = progressive.ProgressiveLSTM()

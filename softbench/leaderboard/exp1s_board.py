@@ -116,7 +116,7 @@ def group(loaded: list[tuple[pathlib.Path, dict]]) -> tuple[Group, ...]:
 
 
 def _paper_cells(robot: str, loop: str, task: str) -> list[str]:
-  table = paper()
+  table, robot = paper(), paper_tables.paper_robot(robot)
   if robot not in table["robots"] or task not in table["scores"][loop]:
     return ["-"] * len(PAPER_METRICS)
   index = table["robots"].index(robot)

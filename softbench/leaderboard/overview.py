@@ -32,7 +32,7 @@ def paper() -> dict:
 
 def paper_mean(robot: str, task: str, agent: str) -> float | None:
   """The paper's mean position error (mm) of ``agent`` on ``robot``'s ``task``, if it has one."""
-  experiment = paper()["experiments"].get(robot)
+  experiment = paper()["experiments"].get(paper_tables.paper_robot(robot))
   if experiment is None or agent not in experiment["agents"] or task not in experiment["scores"]:
     return None
   return experiment["scores"][task][METRIC][experiment["agents"].index(agent)][0]
@@ -80,7 +80,7 @@ def overviews(board: ranking.Leaderboard) -> tuple[Overview, ...]:
     tasks = sorted({task for _, task in estimates}, key=suite.TASKS.index)
     names = sorted({agent for agent, _ in estimates},
                    key=lambda agent: _known_first(agent, agents.AGENTS))
-    experiment = paper()["experiments"].get(robot)
+    experiment = paper()["experiments"].get(paper_tables.paper_robot(robot))
     caption = ("position error (mm), mean ± std over seeds of the module-averaged error; " +
                (f"in brackets the paper's {experiment['name']} mean" if experiment else
                 "the paper has no table for this robot"))
