@@ -16,7 +16,7 @@ run: $(STAMP)
 	$(VENV)/bin/softbench run --task spiral --agent smpl
 
 test: $(STAMP)
-	$(VENV)/bin/python -m pytest -q tests
+	$(VENV)/bin/python -m pytest -q -n auto tests
 
 bench: $(STAMP)
 	$(VENV)/bin/python -m pytest -q benchmarks --benchmark-only --benchmark-columns=mean,stddev,rounds
@@ -24,7 +24,8 @@ bench: $(STAMP)
 models: $(STAMP)
 	$(VENV)/bin/softbench models export --measure-speed
 
-# Every agent on every task of the leaderboard's robots, then the Exp1S protocol, then the pages.
+# Every agent on every task of the leaderboard's robots, then Exp1S on each tendon family, then
+# the pages.
 # PROFILE=paper (default) is the paper's budget: hours per agent on a laptop CPU. A setting that
 # already has a record of this profile in leaderboard/results is skipped, and a run under way
 # resumes from the cached datasets, checkpoints, training snapshots and finished seeds, so an
@@ -32,9 +33,10 @@ models: $(STAMP)
 PROFILE ?= paper
 WORKERS ?=# Processes per run (softbench run --workers); empty: one per core.
 RESULTS := leaderboard/results
-LEADERBOARD_ROBOTS := tendon-3 pneumatic-433
+LEADERBOARD_ROBOTS := tendon-3 tendon-local-3 pneumatic-433
 LEADERBOARD_TASKS := babbling circle rectangle spiral reach
 LEADERBOARD_AGENTS := smpl mlp lstm vae-lstm bilstm reference zero random
+EXP1S_FAMILIES := tendon tendon-local
 leaderboard: $(STAMP)
 	set -e; for robot in $(LEADERBOARD_ROBOTS); do for task in $(LEADERBOARD_TASKS); do \
 	  for agent in $(LEADERBOARD_AGENTS); do \
@@ -43,8 +45,11 @@ leaderboard: $(STAMP)
 	    $(VENV)/bin/softbench run --robot $$robot --task $$task --agent $$agent --profile $(PROFILE) \
 	      $(if $(WORKERS),--workers $(WORKERS)) --results $(RESULTS); \
 	  done; done; done
-	if ls $(RESULTS)/smpl-exp1s-$(PROFILE)-*.json >/dev/null 2>&1; then \
-	  echo "skipped exp1s: it has a $(PROFILE) record"; \
-	else $(VENV)/bin/softbench run --protocol exp1s --agent smpl --profile $(PROFILE) \
-	  $(if $(WORKERS),--workers $(WORKERS)) --results $(RESULTS); fi
+	set -e; for family in $(EXP1S_FAMILIES); do \
+	  named=$$([ $$family = tendon ] || echo "$$family-"); \
+	  if ls $(RESULTS)/smpl-exp1s-$${named}$(PROFILE)-*.json >/dev/null 2>&1; then \
+	    echo "skipped exp1s on $$family: it has a $(PROFILE) record"; continue; fi; \
+	  $(VENV)/bin/softbench run --protocol exp1s --family $$family --agent smpl \
+	    --profile $(PROFILE) $(if $(WORKERS),--workers $(WORKERS)) --results $(RESULTS); \
+	done
 	$(VENV)/bin/softbench leaderboard --results $(RESULTS) --write

@@ -8,6 +8,7 @@ import subprocess
 import pytest
 
 from softbench import agents
+from softbench import robots
 
 MAKEFILE = pathlib.Path(__file__).parent.parent / "Makefile"
 _RECORDING_SOFTBENCH = """#!/bin/sh
@@ -56,7 +57,10 @@ def test_the_fill_runs_every_agent_on_every_task_then_exp1s_then_the_pages(check
   assert len(runs) == (len(_variable("LEADERBOARD_ROBOTS")) * len(_variable("LEADERBOARD_TASKS"))
                        * len(agents.AGENTS))
   assert all("--profile paper" in call for call in runs)
-  assert calls[-2].startswith("run --protocol exp1s --agent smpl --profile paper")
+  exp1s = [call for call in calls if "--protocol exp1s" in call]
+  assert exp1s == [f"run --protocol exp1s --family {family} --agent smpl --profile paper "
+                   f"--results leaderboard/results" for family in robots.TENDON_FAMILIES]
+  assert calls[-len(exp1s) - 1:-1] == exp1s  # After every task's runs.
   assert calls[-1] == "leaderboard --results leaderboard/results --write"
 
 
@@ -69,5 +73,12 @@ def test_an_interrupted_fill_skips_the_settings_that_have_records(checkout):
   calls = _fill(checkout)
   assert not any("--robot tendon-3 --task spiral --agent smpl " in call for call in calls)
   assert sum("--robot tendon-3 --task spiral --agent lstm " in call for call in calls) == 1
-  assert not any("exp1s" in call for call in calls)
+  assert sum("--robot tendon-local-3 --task spiral --agent smpl " in call for call in calls) == 1
+  # The tendon family's Exp1S record does not stand for the tendon-local family's.
+  assert [call for call in calls if "exp1s" in call] == [
+      "run --protocol exp1s --family tendon-local --agent smpl --profile paper "
+      "--results leaderboard/results"]
   assert calls[-1].startswith("leaderboard")
+  (results / "smpl-exp1s-tendon-local-paper-2026-11-24T000000Z.json").touch()
+  (checkout / ".venv" / "bin" / "calls.txt").unlink()
+  assert not any("exp1s" in call for call in _fill(checkout))
