@@ -83,3 +83,14 @@ def test_exp1s_column_retrains_the_column_exp1s_trained(two_stages, monkeypatch,
   assert [weight for weight, _, _ in scores] == ["0", "1"]
   assert scores[0][1:] == (f"{spiral['position_mm']:.2f}", f"{spiral['orientation_deg']:.2f}")
   assert len(re.findall(r"best validation [0-9.]+ at epoch [12]; test action MSE", out)) == 2
+
+
+def test_forward_coupling_compares_both_forward_models_of_every_module(monkeypatch, capsys):
+  data.collect("tendon-local-2", samples=200, seed=0, progress=False)
+  out = run_script("forward_coupling", ["tendon-local-2", "--profile", "tiny"], monkeypatch, capsys)
+  found = re.findall(r"^tendon-local-2 module (\d): .* actuation ([0-9.]+), from every module's "
+                     r"([0-9.]+) \(ratio ([0-9.]+)\)$", out, re.MULTILINE)
+  assert [module for module, *_ in found] == ["1", "2"]
+  for _, own, every, ratio in found:
+    assert float(own) > 0 and float(every) > 0
+    assert float(ratio) == pytest.approx(float(own) / float(every), rel=0.02)
