@@ -94,3 +94,16 @@ def test_forward_coupling_compares_both_forward_models_of_every_module(monkeypat
   for _, own, every, ratio in found:
     assert float(own) > 0 and float(every) > 0
     assert float(ratio) == pytest.approx(float(own) / float(every), rel=0.02)
+
+
+def test_plant_comparison_sets_both_robots_side_by_side(monkeypatch, capsys):
+  # On the committed records: the default-profile spiral of tendon-3 and tendon-local-3.
+  results = pathlib.Path(__file__).parent.parent / "leaderboard" / "results"
+  out = run_script("plant_comparison", ["--results", str(results)], monkeypatch, capsys)
+  header = next(line for line in out.splitlines() if line.startswith("| agent |"))
+  spiral = header.split(" | ").index("spiral")
+  row = next(line for line in out.splitlines() if line.startswith("| smpl |"))
+  first, second = row.split(" | ")[spiral].split(" -> ")
+  assert re.fullmatch(r"[0-9.]+ ± [0-9.]+", first) and re.fullmatch(r"[0-9.]+ ± [0-9.]+", second)
+  ranked = re.search(r"^spiral on tendon-local-3, learned agents from best: (.+)$", out, re.M)
+  assert "smpl" in ranked.group(1)
