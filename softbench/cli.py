@@ -401,8 +401,9 @@ def build_parser() -> argparse.ArgumentParser:
                   "and prints the errors over seeds.")
   run_parser.add_argument("--task", help=f"one of {', '.join(suite.TASKS)}")
   run_parser.add_argument("--protocol", help=f"{continual.PROTOCOL}: SMPL learns tendon-1 .. "
-                                             f"tendon-5 in sequence; prints the paper's Exp1S "
-                                             f"table and the forgetting matrix")
+                                             f"tendon-5 (or another --family's arms) in sequence; "
+                                             f"prints the paper's Exp1S table and the forgetting "
+                                             f"matrix")
   run_parser.add_argument("--family", help=f"with --protocol {continual.PROTOCOL}: the tendon "
                                            f"family whose arms 1 .. 5 SMPL learns, one of "
                                            f"{', '.join(robots.TENDON_FAMILIES)} (default "
