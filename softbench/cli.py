@@ -22,6 +22,7 @@ from softbench import run as run_module
 from softbench import storage
 from softbench import suite
 from softbench import tuning
+from softbench import zoo
 from softbench.adaptive import plot as adaptive_plot
 from softbench.agents import hyperparameters
 from softbench.data import dataset
@@ -30,6 +31,8 @@ from softbench.rendering import options as video_options
 from softbench.rendering import replay as episode_replay
 from softbench.rendering import video
 from softbench.robots import export as model_export
+from softbench.zoo import catalogue as zoo_catalogue
+from softbench.zoo import verification as zoo_verification
 
 EXIT_USAGE = 2
 EXIT_FAILURE = 1  # The run itself failed (not the input).
@@ -327,6 +330,78 @@ def _retrain(args: argparse.Namespace) -> None:
     run_module.write_record(record, pathlib.Path(args.json))
 
 
+def _zoo_folder(args: argparse.Namespace, create: bool = False) -> pathlib.Path:
+  """The zoo a ``softbench zoo`` command works on: ``--zoo``, else the one in use."""
+  chosen = pathlib.Path(args.zoo) if args.zoo else zoo.location()
+  if chosen is None:
+    raise ValueError(f"the zoo is turned off (${zoo.VARIABLE}={zoo.OFF}); name one with --zoo DIR")
+  if create:
+    return storage.check_writable(chosen, "the zoo", folder=True)
+  if not chosen.is_dir():
+    raise ValueError(f"no zoo at {chosen}: not a folder (name one with --zoo DIR or "
+                     f"${zoo.VARIABLE})")
+  return chosen
+
+
+def _zoo_list(args: argparse.Namespace) -> None:
+  folder = _zoo_folder(args)
+  entries = zoo.read_manifest(folder)
+  print(f"{'kind':<15} {'KiB':>8} {'records':>7}  path")
+  for path, entry in sorted(entries.items()):
+    print(f"{entry.kind:<15} {entry.bytes / 1024:>8.1f} {len(entry.records):>7}  {path}")
+  print(f"{len(entries)} files, {zoo.size_bytes(entries) / 2**20:.1f} MiB of "
+        f"{zoo.BUDGET_BYTES / 2**20:.0f} MiB ({folder})")
+  for problem in zoo.check_files(folder):
+    print(f"problem: {problem}")
+
+
+def _zoo_add(args: argparse.Namespace) -> None:
+  family = None
+  if args.protocol is not None:
+    if args.protocol != continual.PROTOCOL:
+      raise ValueError(f"unknown protocol {args.protocol!r}; the zoo keeps {continual.PROTOCOL}'s")
+    family = args.family or continual.DEFAULT_FAMILY
+  elif args.family is not None:
+    raise ValueError(f"--family goes with --protocol {continual.PROTOCOL}")
+  chosen = zoo_catalogue.setting(args.agent, args.robot, family, args.profile, args.seeds)
+  folder = _zoo_folder(args, create=True)
+  linked = zoo_catalogue.records_of(chosen, pathlib.Path(args.results))
+  files = zoo_catalogue.cache_files(chosen)
+  added = zoo.add([(path, kind) for _, path, kind in files],
+                  {path: linked[seed] for seed, path, kind in files if kind == "agent"}, folder)
+  for entry in added:
+    print(f"added {entry.path} ({entry.kind}, {entry.bytes / 1024:.1f} KiB, "
+          f"{len(entry.records)} records)")
+  print(f"zoo: {zoo.size_bytes(zoo.read_manifest(folder)) / 2**20:.1f} MiB of "
+        f"{zoo.BUDGET_BYTES / 2**20:.0f} MiB ({folder})")
+
+
+def _zoo_verify(args: argparse.Namespace) -> None:
+  folder = _zoo_folder(args)
+  for name in args.agents or ():
+    agents.describe(name)
+  problems = zoo.check_files(folder)
+  if problems:
+    raise ValueError(f"{folder}: {problems[0]} ({len(problems)} problems; see softbench zoo list)")
+
+  def report(check) -> None:
+    verdict = "identical" if check.identical else f"DIFFERS: {check.detail}"
+    print(f"{check.record} seed {check.seed}: {verdict} ({check.seconds:.1f} s)", flush=True)
+
+  checks = zoo_verification.verify(pathlib.Path(args.results), folder,
+                                   tuple(args.agents) if args.agents else None, args.quick,
+                                   report)
+  differing = [check for check in checks if not check.identical]
+  print(f"{len(checks) - len(differing)} of {len(checks)} re-scored seeds identical to their "
+        f"records")
+  if differing:
+    raise ZooMismatch(f"{len(differing)} re-scored seeds differ from their records")
+
+
+class ZooMismatch(RuntimeError):
+  """``softbench zoo verify`` found a record that the zoo's weights do not reproduce."""
+
+
 _FAULT_HELP = ("a faulty actuator, MODULE:ACTUATOR:GAIN (module from 1, actuator from 0 within "
                "the module: cable xpos, ypos, xneg, yneg of a tendon arm, bellows 0.. (MJCF "
                "bellows1..) of the pneumatic arm; gain in [0, 1], 0 punctured); repeat for "
@@ -484,6 +559,7 @@ def build_parser() -> argparse.ArgumentParser:
   _add_profile_argument(retrain_parser)
   _add_record_arguments(retrain_parser)
   retrain_parser.set_defaults(run=_retrain)
+  _add_zoo_parser(commands)
   models = commands.add_parser("models", help="exported MJCF models")
   models_commands = models.add_subparsers(dest="models_command", required=True)
   export_parser = models_commands.add_parser("export", help="write models/<name>/ for every robot")
@@ -494,6 +570,45 @@ def build_parser() -> argparse.ArgumentParser:
                              help="also measure simulation speed into speed.json")
   export_parser.set_defaults(run=_models_export)
   return parser
+
+
+def _add_zoo_parser(commands) -> None:
+  zoo_parser = commands.add_parser(
+      "zoo", help="trained weights kept in the repository: list, add, verify",
+      description="The zoo holds the weights behind leaderboard records (and the saved state of "
+                  "unfinished trainings); softbench run takes them instead of training.")
+  zoo_commands = zoo_parser.add_subparsers(dest="zoo_command", required=True)
+  zoo_help = f"the zoo folder (default ${zoo.VARIABLE}, else zoo/ of the checkout)"
+  list_parser = zoo_commands.add_parser("list", help="the zoo's files, sizes and records")
+  list_parser.add_argument("--zoo", help=zoo_help)
+  list_parser.set_defaults(run=_zoo_list)
+  add_parser = zoo_commands.add_parser(
+      "add", help="copy a setting's trained weights (or unfinished training) into the zoo",
+      description="Copies each seed's checkpoint and forward models from the data home into the "
+                  "zoo, or the saved state of a training still under way, and links the records "
+                  "in --results that they stand behind.")
+  add_parser.add_argument("--agent", help="a learned agent")
+  add_parser.add_argument("--robot", help="the robot it was trained on")
+  add_parser.add_argument("--protocol", help=f"{continual.PROTOCOL}: the Exp1S networks instead")
+  add_parser.add_argument("--family", help=f"with --protocol {continual.PROTOCOL}: one of "
+                                           f"{', '.join(robots.TENDON_FAMILIES)}")
+  add_parser.add_argument("--seeds", type=int, help="seeds 0 .. N-1 (default: the profile's)")
+  _add_profile_argument(add_parser)
+  add_parser.add_argument("--results", default=str(leaderboard.DEFAULT_RESULTS),
+                          help="folder of the records to link")
+  add_parser.add_argument("--zoo", help=zoo_help)
+  add_parser.set_defaults(run=_zoo_add)
+  verify_parser = zoo_commands.add_parser(
+      "verify", help="re-score records from the zoo alone and compare them",
+      description="Re-scores, in an empty data home, every record the zoo's agents stand "
+                  "behind, seed by seed, and compares each figure with the record's.")
+  verify_parser.add_argument("--agents", nargs="+", metavar="AGENT", help="only these agents")
+  verify_parser.add_argument("--quick", action="store_true",
+                             help="seed 0 only, one record per checkpoint")
+  verify_parser.add_argument("--results", default=str(leaderboard.DEFAULT_RESULTS),
+                             help="folder of the records")
+  verify_parser.add_argument("--zoo", help=zoo_help)
+  verify_parser.set_defaults(run=_zoo_verify)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -508,7 +623,8 @@ def main(argv: list[str] | None = None) -> int:
   except (ValueError, FileNotFoundError, FloatingPointError, video.RenderingUnavailable) as error:
     print(f"softbench: error: {dataset.first_line(error)}", file=sys.stderr)
     return EXIT_USAGE
-  except (run_module.WorkerDied, video.RenderingFailed, continual.ForgettingDetected) as error:
+  except (run_module.WorkerDied, video.RenderingFailed, continual.ForgettingDetected,
+          ZooMismatch) as error:
     print(f"softbench: error: {dataset.first_line(error)}", file=sys.stderr)
     return EXIT_FAILURE
   except control.PhysicsError as error:  # MuJoCo's state blew up during an episode.

@@ -36,6 +36,7 @@ from softbench import profiles
 from softbench import protocols
 from softbench import robots
 from softbench import suite
+from softbench import zoo
 from softbench.agents import hyperparameters
 from softbench.agents import learned
 from softbench.data import dataset
@@ -128,6 +129,13 @@ def _train(seed: int, profile: profiles.Profile, show: bool, family: str):
 def _matrices(outcome: smpl_protocol.ProgressiveRun) -> dict[str, np.ndarray]:
   return {f"forgetting/{metric}": outcome.forgetting_matrix(metric).numpy()
           for metric in ("pose_mse", "action_mse")}
+
+
+def checkpoint_path(seed: int, profile: profiles.Profile,
+                    family: str = DEFAULT_FAMILY) -> pathlib.Path:
+  """Where ``build`` caches the Exp1S network of ``seed`` (it exists once trained)."""
+  arms = [arm for arm, _ in protocol(family).column_views()]
+  return learned.checkpoint_file(_config(seed, profile, arms))
 
 
 def build(seed: int, profile: profiles.Profile, show_progress: bool = False,
@@ -265,7 +273,8 @@ def execute(profile: profiles.Profile, seeds: int | None = None, show_progress: 
   seeds = profile.seeds if seeds is None else seeds
   dataset.check_count("seeds", seeds)
   sequence = protocol(family)
-  for arm, _ in sequence.column_views():  # Every core collects, before the seeds.
+  taken, trained = zoo.take([checkpoint_path(seed, profile, family) for seed in range(seeds)])
+  for arm, _ in [] if trained else sequence.column_views():  # Every core, before the seeds.
     data.collect(arm, samples=profile.samples, seed=learned.DATA_SEED, progress=show_progress)
   if show_progress:
     episode_snapshots.report_resuming(finished_seeds_folder(profile, family), seeds)
@@ -278,7 +287,7 @@ def execute(profile: profiles.Profile, seeds: int | None = None, show_progress: 
           "robots": list(sequence.robot_names),
           "tasks": list(TASKS), "profile": profile.name,
           "profile_settings": dataclasses.asdict(profile), "seeds": seeds, "per_seed": per_seed,
-          "wall_time_s": round(time.perf_counter() - started, 3)}
+          **zoo.section(taken), "wall_time_s": round(time.perf_counter() - started, 3)}
 
 
 def mean_forgetting(record: dict) -> np.ndarray:

@@ -41,6 +41,7 @@ from softbench import metrics
 from softbench import profiles
 from softbench import robots
 from softbench import suite
+from softbench import zoo
 from softbench.agents import learned
 from softbench.data import dataset
 from softbench.leaderboard import records
@@ -229,6 +230,12 @@ def _episode_and_arm(run: RunSettings, seed: int, show_progress: bool
   return episode_on(agent, faulty, run, seed, show_progress), faulty
 
 
+def score_seed(run: RunSettings, seed: int) -> dict:
+  """``seed_episode``'s record entry, without progress bars or kept episodes."""
+  episode, arm = _episode_and_arm(run, seed, False)
+  return seed_entry(seed, episode, arm)
+
+
 def _run_seed(seed: int, run: RunSettings,
               show_progress: bool) -> tuple[dict, evaluation.Episode]:
   """The episode of ``seed`` (``seed_episode``, or the one an interrupted run of the same
@@ -356,14 +363,23 @@ def execute(run: RunSettings, show_progress: bool = True, workers: int | None = 
 def execute_episodes(run: RunSettings, show_progress: bool = True, workers: int | None = None,
                      keep_seeds: bool = False) -> tuple[dict, list[evaluation.Episode]]:
   """``execute``, also returning every seed's episode (in seed order) for plots and videos;
+  a learned agent's checkpoints that the data home lacks are taken from the zoo where it holds
+  them (``softbench.zoo``; the record then names them in a ``zoo`` section), and the babbling
+  dataset is collected only if some seed still has to train;
   none for an adaptive run (``softbench.adaptive`` draws its own figure). The finished seeds
   kept for resuming are discarded at the end unless ``keep_seeds``: then the caller discards
   them (``episode_snapshots.discard``) once the record is safely written."""
   started, origin = time.perf_counter(), provenance()
   arm = robots.make(run.robot)
-  if agents.describe(run.agent).learned:
-    data.collect(run.robot, samples=run.profile.samples, seed=learned.DATA_SEED,
-                 progress=show_progress)
+  taken = []
+  learner = agents.learner(run.agent)
+  if learner is not None:
+    taken, trained = zoo.take([learned.checkpoint_path(run.agent, arm, seed, run.profile,
+                                                       learner.per_module)
+                               for seed in range(run.seeds)])
+    if not trained:
+      data.collect(run.robot, samples=run.profile.samples, seed=learned.DATA_SEED,
+                   progress=show_progress)
   if run.adaptive:
     section = adaptive_activation.run(run.robot, run.agent, run.profile, run.targets,
                                       run.module, run.eval_mode, run.helpers, show_progress)
@@ -384,7 +400,7 @@ def execute_episodes(run: RunSettings, show_progress: bool = True, workers: int 
       "profile_settings": dataclasses.asdict(run.profile), "eval_mode": run.eval_mode,
       "trajectory": run.trajectory, "seeds": run.seeds,
       "faults": [fault_model.describe(arm, fault) for fault in run.faults], **results,
-      "wall_time_s": round(time.perf_counter() - started, 3),
+      **zoo.section(taken), "wall_time_s": round(time.perf_counter() - started, 3),
   }
   return record, [] if run.adaptive else [episode for _, episode in outcomes]
 

@@ -1,5 +1,6 @@
 """Fixtures shared by the test files."""
 
+import contextlib
 import dataclasses
 import os
 import subprocess
@@ -7,10 +8,46 @@ import sys
 
 import pytest
 
+from smpl import snapshots
+from smpl import training
+
 from softbench import continual
 from softbench import data
 from softbench import leaderboard
 from softbench import protocols
+from softbench import zoo
+
+
+@pytest.fixture(autouse=True)
+def no_repository_zoo(monkeypatch):
+  """Tests train what they use: the repository's zoo stays out unless a test names a zoo."""
+  monkeypatch.setenv(zoo.VARIABLE, zoo.OFF)
+
+
+@pytest.fixture
+def interrupted_training(monkeypatch):
+  """A context manager within which training stops with KeyboardInterrupt in its fourth epoch
+  (every agent has run at least one whole fit by then, and one epoch of the fit under way),
+  snapshots saved at every epoch."""
+  monkeypatch.setattr(snapshots, "SAVE_INTERVAL_S", 0.0)
+
+  @contextlib.contextmanager
+  def interrupted():
+    epochs, train_epoch = 0, training._train_epoch
+
+    def interrupted_in_the_fourth_epoch(*args):
+      nonlocal epochs
+      epochs += 1
+      if epochs == 4:
+        raise KeyboardInterrupt
+      return train_epoch(*args)
+
+    with monkeypatch.context() as patched:
+      patched.setattr(training, "_train_epoch", interrupted_in_the_fourth_epoch)
+      with pytest.raises(KeyboardInterrupt):
+        yield
+
+  return interrupted
 
 
 @pytest.fixture

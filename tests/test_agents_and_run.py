@@ -10,8 +10,6 @@ import pytest
 import torch
 from dm_control.rl import control
 
-from smpl import snapshots
-from smpl import training
 from softbench import agents
 from softbench import cli
 from softbench import data
@@ -136,31 +134,19 @@ def test_a_folder_at_a_checkpoint_path_is_a_one_line_error_and_stays(tmp_path, m
 
 
 @pytest.mark.parametrize("agent_name", LEARNED_AGENTS)
-def test_interrupted_training_resumes_to_the_same_checkpoint(agent_name, tmp_path, monkeypatch):
+def test_interrupted_training_resumes_to_the_same_checkpoint(agent_name, interrupted_training,
+                                                             tmp_path, monkeypatch):
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
-  monkeypatch.setattr(snapshots, "SAVE_INTERVAL_S", 0.0)
   agents.make(agent_name, "tendon-2", 0, "tiny")
   (checkpoint,) = (tmp_path / learned.CHECKPOINT_FOLDER).glob(f"{agent_name}-*.pt")
   uninterrupted = torch.load(checkpoint, weights_only=False)["state_dict"]
   checkpoint.unlink()
   shutil.rmtree(tmp_path / forward_models.FOLDER)  # From scratch: the forward models too.
-  epochs, train_epoch = 0, training._train_epoch
-
-  def interrupted_in_the_fourth_epoch(*args):
-    # Every agent has run at least one whole fit by then, and one epoch of the fit under way.
-    nonlocal epochs
-    epochs += 1
-    if epochs == 4:
-      raise KeyboardInterrupt
-    return train_epoch(*args)
-
-  monkeypatch.setattr(training, "_train_epoch", interrupted_in_the_fourth_epoch)
-  with pytest.raises(KeyboardInterrupt):
+  with interrupted_training():
     agents.make(agent_name, "tendon-2", 0, "tiny")
   # The fit under way kept a snapshot: an inverse model's in the checkpoint's folder, or (SMPL,
   # with a forward model per module) a forward model's in its cache file's folder.
   assert list(tmp_path.rglob("*.partial/fit-1.pt"))
-  monkeypatch.setattr(training, "_train_epoch", train_epoch)
   agents.make(agent_name, "tendon-2", 0, "tiny")
   resumed = torch.load(checkpoint, weights_only=False)["state_dict"]
   assert resumed.keys() == uninterrupted.keys()

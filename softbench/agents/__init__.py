@@ -55,4 +55,10 @@ def make(name: str, robot: str | robots.SoftArm, seed: int = 0,
   return build(arm, seed, profile, show_progress)
 
 
-__all__ = ["AGENTS", "Agent", "EpisodeInfo", "describe", "make"]
+def learner(name: str):
+  """The ``softbench.agents.learned.Learner`` of a learned agent, None for the others."""
+  entry = describe(name)
+  return importlib.import_module(entry.module).LEARNER if entry.learned else None
+
+
+__all__ = ["AGENTS", "Agent", "EpisodeInfo", "describe", "learner", "make"]

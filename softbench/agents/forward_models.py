@@ -5,8 +5,8 @@ training config (the paper's, seeded by the agent's seed), not on the inverse mo
 through it. So the agents that read the same view with the same seed and profile (the four
 baselines' whole-arm model) and every trial of a tuning study share one: trained as
 ``softbench.protocols.prepare_column`` trains it, cached under ``$SOFTBENCH_HOME/forward`` by a
-hash of everything its weights depend on (``ForwardModelConfig``), and loaded with the weights a
-fresh training gives, to the bit. An interrupted training resumes from its snapshots
+hash of everything its weights depend on (``ForwardModelConfig``), or taken from the zoo
+(``softbench.zoo``), and loaded with the weights a fresh training gives, to the bit. An interrupted training resumes from its snapshots
 (``smpl.snapshots``, in the cache file's ``.partial`` folder); a damaged cache file is reported
 and trained again.
 """
@@ -24,6 +24,7 @@ from smpl import training
 from softbench import data
 from softbench import protocols
 from softbench import storage
+from softbench import zoo
 from softbench.robots import base as robot_base
 
 FOLDER = "forward"  # Under the data home.
@@ -56,6 +57,16 @@ def cache_file(config: ForwardModelConfig) -> pathlib.Path:
   return storage.softbench_home() / FOLDER / f"{config.key}.pt"
 
 
+def configs(robot: robot_base.SoftArm, views: list[data.View], samples: int, data_seed: int,
+            config: training.ForwardTrainingConfig, training_version: int
+            ) -> list[ForwardModelConfig]:
+  """The cache configs of ``views``' forward models trained with ``config`` (``prepare``)."""
+  xml_sha256 = hashlib.sha256(robot.to_xml().encode()).hexdigest()
+  return [ForwardModelConfig(robot.name, xml_sha256, view.name, samples, data_seed, config.seed,
+                             config.max_epochs, config.patience, config.compile, training_version)
+          for view in views]
+
+
 def prepare(robot: robot_base.SoftArm, views: list[data.View], dataset: data.Dataset,
             samples: int, data_seed: int, config: training.ForwardTrainingConfig,
             training_version: int, progress_label: str | None = None
@@ -63,14 +74,12 @@ def prepare(robot: robot_base.SoftArm, views: list[data.View], dataset: data.Dat
   """Each view's windows of ``dataset`` (``samples`` babbling samples of seed ``data_seed``) and
   its frozen forward model trained with ``config``: from the cache, or trained now (with an epoch
   progress bar named ``progress_label VIEW`` if given) and cached."""
-  xml_sha256 = hashlib.sha256(robot.to_xml().encode()).hexdigest()
   windows, forwards = [], []
-  for view in views:
-    key = ForwardModelConfig(robot.name, xml_sha256, view.name, samples, data_seed, config.seed,
-                             config.max_epochs, config.patience, config.compile,
-                             training_version)
+  for view, key in zip(views, configs(robot, views, samples, data_seed, config,
+                                      training_version)):
     path = cache_file(key)
     partial = path.with_suffix(".partial")  # Its training snapshots until it is saved.
+    zoo.restore(path)
     cached = _load(path, key, dataset, view) if path.exists() else None
     if cached:
       split, model = cached

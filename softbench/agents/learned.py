@@ -53,6 +53,7 @@ from smpl.inverse import InverseModel
 from softbench import data
 from softbench import profiles
 from softbench import storage
+from softbench import zoo
 from softbench.agents import base
 from softbench.agents import forward_models
 from softbench.agents import hyperparameters
@@ -381,6 +382,17 @@ def checkpoint_path(name: str, robot: robot_base.SoftArm, seed: int, profile: pr
                                         hyperparameters.values(name, robot.name)))
 
 
+def cache_files(name: str, robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
+                per_module: bool) -> list[tuple[pathlib.Path, str]]:
+  """The files the data home caches for agent ``name`` of ``seed``, each with its zoo kind: the
+  agent's checkpoint, then the forward models it trains through."""
+  views = Learner(name, per_module).views(robot)
+  forwards = forward_models.configs(robot, views, profile.samples, DATA_SEED,
+                                    forward_config(seed, profile), TRAINING_VERSION)
+  return ([(checkpoint_path(name, robot, seed, profile, per_module), "agent")]
+          + [(forward_models.cache_file(config), "forward") for config in forwards])
+
+
 def checkpoint_file(config: TrainedConfig) -> pathlib.Path:
   """The checkpoint named by ``config``."""
   return storage.softbench_home() / CHECKPOINT_FOLDER / f"{config.key}.pt"
@@ -400,12 +412,13 @@ def load_or_train(path: pathlib.Path, config, parts: list[str],
                   untrained_models: Callable[[], tuple[InverseModel,
                                                        list[smpl_forward.ForwardModel]]],
                   train: Callable[[], TrainedModels]) -> TrainedModels:
-  """The models of the checkpoint at ``path`` (saved for ``config``) when it exists and passes its
-  checks, loaded into ``untrained_models()``. Otherwise ``train()``'s (a damaged checkpoint is
+  """The models of the checkpoint at ``path`` (saved for ``config``) when it exists, or the zoo
+  holds it (``softbench.zoo``), and it passes its checks, loaded into ``untrained_models()``. Otherwise ``train()``'s (a damaged checkpoint is
   reported with a ``data.CorruptFileWarning``), trained so that an interrupted training resumes
   (snapshots in ``snapshot_folder(path)``) and then saved there: normalisation i as
   ``parts[i]/KEY``, the further arrays under their own names (no part's prefix)."""
   stored = None
+  zoo.restore(path)
   if path.exists():
     inverse, forwards = untrained_models()
     stored = checkpoint.load_cached(path, bundle(inverse, forwards), config,

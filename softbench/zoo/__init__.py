@@ -1,0 +1,270 @@
+"""The zoo: trained weights kept in the repository, so that a fresh clone re-scores a record
+without training, and a long training goes on from another machine.
+
+``zoo/`` holds files laid out as in the data home, each under the path the cache looks for:
+
+- ``checkpoints/KEY.pt``: a trained agent (an Exp2S agent or an Exp1S network), weights only;
+- ``forward/KEY.pt``: a frozen forward model, shared by the agents that read its view;
+- ``checkpoints/KEY.partial/fit-N.pt`` (or ``forward/KEY.partial/...``): the saved state of a
+  training that has not finished (``smpl.snapshots``), optimiser included, so that it resumes
+  to the same weights; removed once that checkpoint is in.
+
+``zoo/manifest.json`` lists every file with its sha256, size, kind, the cache key it answers (and
+the configuration stored in it) and the records it stands behind. Before the cache trains a model
+it asks the zoo (``restore``): a file the data home lacks is copied in, after its sha256 is
+checked, with one line on stderr; a damaged or tampered file is refused with one warning and the
+model is trained instead. Everything else (checking the configuration, the weights' own hash) is
+the cache's usual loading.
+
+The zoo is ``$SOFTBENCH_ZOO`` if set (``none`` turns it off), else the ``zoo/`` folder of the
+source checkout softbench runs from.
+"""
+
+import dataclasses
+import hashlib
+import json
+import os
+import pathlib
+import sys
+import warnings
+
+import torch
+
+from smpl.checkpoint import first_line
+from softbench import storage
+
+VARIABLE = "SOFTBENCH_ZOO"
+OFF = "none"
+MANIFEST = "manifest.json"
+FORMAT = "softbench-zoo"
+VERSION = 1
+KINDS = ("agent", "forward", "training-state")
+BUDGET_BYTES = 100 * 2**20  # (bytes) What the repository's zoo may hold in all.
+PARTIAL_SUFFIX = ".partial"  # A cache file's training state: KEY.partial/ beside KEY.pt.
+_REPOSITORY_ZOO = pathlib.Path(__file__).resolve().parents[2] / "zoo"  # Of a source checkout.
+
+
+class ZooWarning(UserWarning):
+  """A zoo file or manifest that cannot be used; the model is trained instead."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Entry:
+  """One file of the zoo; ``path`` is relative to the zoo and to the data home alike."""
+
+  path: str
+  sha256: str
+  bytes: int
+  kind: str
+  key: str  # The cache key the file answers (a checkpoint's file name without .pt).
+  config: dict = dataclasses.field(default_factory=dict)  # As stored in the checkpoint.
+  records: tuple[str, ...] = ()  # File names of the records it stands behind.
+
+  def to_json(self) -> dict:
+    return {**dataclasses.asdict(self), "records": list(self.records)}
+
+
+def location() -> pathlib.Path | None:
+  """Where the zoo is, whether or not it exists yet: ``$SOFTBENCH_ZOO``, else ``zoo/`` of the
+  checkout; None when ``$SOFTBENCH_ZOO`` is ``none``."""
+  chosen = os.environ.get(VARIABLE)
+  if chosen == OFF:
+    return None
+  return pathlib.Path(chosen).expanduser() if chosen else _REPOSITORY_ZOO
+
+
+def folder() -> pathlib.Path | None:
+  """The zoo in use: ``location()`` if it is a folder, else None."""
+  path = location()
+  return path if path is not None and path.is_dir() else None
+
+
+def file_sha256(path: pathlib.Path) -> str:
+  return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def read_manifest(zoo: pathlib.Path) -> dict[str, Entry]:
+  """The entries of ``zoo``'s manifest by path; none if it has no manifest.
+
+  Raises:
+    ValueError: the manifest is not a readable zoo manifest (one line naming it).
+  """
+  path = zoo / MANIFEST
+  if not path.exists():
+    return {}
+  try:
+    content = json.loads(path.read_text())
+    if content.get("format") != FORMAT or content.get("version") != VERSION:
+      raise ValueError(f"not a {FORMAT} manifest of version {VERSION}")
+    entries = [Entry(**{**entry, "records": tuple(entry["records"])})
+               for entry in content["entries"]]
+    if any(entry.kind not in KINDS or not _inside(entry.path) for entry in entries):
+      raise ValueError("an entry of unknown kind or with a path outside the zoo")
+  except Exception as error:  # Any damage (bad JSON, a missing or extra field, a wrong type).
+    raise ValueError(f"{path}: unreadable zoo manifest ({type(error).__name__}: "
+                     f"{first_line(error)})") from None
+  return {entry.path: entry for entry in entries}
+
+
+def _inside(relative: str) -> bool:
+  """Whether a manifest path stays inside its folder (no absolute path, no '..')."""
+  parts = pathlib.PurePosixPath(relative).parts
+  return bool(parts) and not pathlib.PurePosixPath(relative).is_absolute() and ".." not in parts
+
+
+def write_manifest(zoo: pathlib.Path, entries: dict[str, Entry]) -> None:
+  content = {"format": FORMAT, "version": VERSION,
+             "entries": [entries[path].to_json() for path in sorted(entries)]}
+  storage.write_atomically(zoo / MANIFEST, json.dumps(content, indent=1, sort_keys=True) + "\n")
+
+
+def _say(message: str) -> None:
+  print(f"softbench: zoo: {message}", file=sys.stderr, flush=True)
+
+
+def restore(cache_file: pathlib.Path) -> list[str]:
+  """Brings what the zoo holds for ``cache_file`` (a checkpoint or forward model under the data
+  home) into the data home, if the home lacks it: the finished file, else the saved state of its
+  unfinished training when the home has none of its own. Returns the zoo paths taken.
+
+  A file whose bytes differ from the manifest's sha256 is refused with a ``ZooWarning`` (one
+  line), as is an unreadable manifest; the model is then trained as if the zoo had nothing."""
+  zoo = folder()
+  home = storage.softbench_home()
+  try:
+    relative = cache_file.resolve().relative_to(home.resolve()).as_posix()
+  except ValueError:  # Not a cache file of the data home.
+    return []
+  if zoo is None or cache_file.exists():
+    return []
+  try:
+    entries = read_manifest(zoo)
+  except ValueError as error:
+    warnings.warn(f"{error}; training instead", ZooWarning, stacklevel=2)
+    return []
+  if relative in entries and _copy_checked(zoo, entries[relative], home):
+    _say(f"took {relative} instead of training it (sha256 checked)")
+    return [relative]
+  partial = pathlib.PurePosixPath(relative).with_suffix(PARTIAL_SUFFIX).as_posix()
+  state = [entry for path, entry in sorted(entries.items()) if path.startswith(partial + "/")]
+  if not state or (home / partial).exists():
+    return []
+  taken = [entry.path for entry in state if _copy_checked(zoo, entry, home)]
+  if taken:
+    _say(f"resuming the training of {pathlib.PurePosixPath(relative).stem} from its saved "
+         f"state ({len(taken)} of {len(state)} files)")
+  return taken
+
+
+def take(cache_files: list[pathlib.Path]) -> tuple[list[str], bool]:
+  """``restore`` for each cache file: the zoo paths taken, and whether every file is now in the
+  data home (then none of them trains, and the babbling data behind them is not needed)."""
+  taken = [path for cache_file in cache_files for path in restore(cache_file)]
+  return taken, all(cache_file.is_file() for cache_file in cache_files)
+
+
+def section(taken: list[str]) -> dict:
+  """The record section that names the zoo files a run took (none: no section)."""
+  return {"zoo": {"files": sorted(taken)}} if taken else {}
+
+
+def _copy_checked(zoo: pathlib.Path, entry: Entry, home: pathlib.Path) -> bool:
+  """Copies the zoo's ``entry`` into the data home if its bytes match the manifest's sha256."""
+  source = zoo / entry.path
+  try:
+    content = source.read_bytes()
+  except OSError as error:
+    warnings.warn(f"{source}: unreadable zoo file ({first_line(error)}); training "
+                  f"instead", ZooWarning, stacklevel=3)
+    return False
+  if hashlib.sha256(content).hexdigest() != entry.sha256:
+    warnings.warn(f"{source}: its sha256 differs from the zoo manifest's (damaged or tampered); "
+                  f"refused, training instead", ZooWarning, stacklevel=3)
+    return False
+  storage.write_atomically(home / entry.path, content)
+  return True
+
+
+def stored_config(path: pathlib.Path) -> dict:
+  """The configuration a checkpoint file was saved with (``smpl.checkpoint``), or {}."""
+  try:
+    payload = torch.load(path, map_location="cpu", weights_only=True)
+    return dict(payload["config"])
+  except Exception:  # Not a checkpoint (a training snapshot): no configuration to list.
+    return {}
+
+
+def add(cache_files: list[tuple[pathlib.Path, str]], records_of: dict[pathlib.Path, list[str]],
+        zoo: pathlib.Path, budget_bytes: int | None = BUDGET_BYTES) -> list[Entry]:
+  """Copies each ``(cache file, kind)`` from the data home into ``zoo``, or, for one not yet
+  written, the saved state of its unfinished training (``KEY.partial/``); a finished file
+  replaces the training state the zoo held for it. ``records_of`` names the records each file
+  stands behind. Returns the new or changed entries.
+
+  Raises:
+    ValueError: a file is neither in the data home nor under way there, or the zoo would
+      outgrow ``budget_bytes`` (one line; nothing is changed).
+  """
+  home = storage.softbench_home()
+  entries = read_manifest(zoo)
+  planned: dict[str, tuple[pathlib.Path, Entry]] = {}
+  for cache_file, kind in cache_files:
+    relative = cache_file.relative_to(home).as_posix()
+    partial = cache_file.with_suffix(PARTIAL_SUFFIX)
+    if cache_file.is_file():
+      sources = [(cache_file, kind, stored_config(cache_file))]
+    elif partial.is_dir() and any(partial.iterdir()):
+      sources = [(path, "training-state", {}) for path in sorted(partial.iterdir())
+                 if path.is_file()]
+    else:
+      raise ValueError(f"{cache_file} is neither trained nor being trained in the data home "
+                       f"{home}; run its training first")
+    for source, source_kind, config in sources:
+      path = source.relative_to(home).as_posix()
+      records = tuple(sorted(set(records_of.get(cache_file, ())) | set(
+          entries[path].records if path in entries else ())))
+      planned[path] = (source, Entry(path, file_sha256(source), source.stat().st_size,
+                                     source_kind, cache_file.stem, config, records))
+    if cache_file.is_file():  # Its training state is no longer needed.
+      prefix = pathlib.PurePosixPath(relative).with_suffix(PARTIAL_SUFFIX).as_posix() + "/"
+      entries = {path: entry for path, entry in entries.items() if not path.startswith(prefix)}
+  updated = {**entries, **{path: entry for path, (_, entry) in planned.items()}}
+  total = sum(entry.bytes for entry in updated.values())
+  if budget_bytes is not None and total > budget_bytes:
+    raise ValueError(f"the zoo would hold {total / 2**20:.1f} MiB, over its budget of "
+                     f"{budget_bytes / 2**20:.0f} MiB; nothing was added")
+  for path, (source, _) in planned.items():
+    storage.write_atomically(zoo / path, source.read_bytes())
+  for stale in set(read_manifest(zoo)) - set(updated):
+    (zoo / stale).unlink(missing_ok=True)
+    _remove_empty_parents(zoo / stale, zoo)
+  write_manifest(zoo, updated)
+  return [entry for _, entry in planned.values()]
+
+
+def _remove_empty_parents(path: pathlib.Path, root: pathlib.Path) -> None:
+  parent = path.parent
+  while parent != root and parent.is_dir() and not any(parent.iterdir()):
+    parent.rmdir()
+    parent = parent.parent
+
+
+def size_bytes(entries: dict[str, Entry]) -> int:
+  return sum(entry.bytes for entry in entries.values())
+
+
+def check_files(zoo: pathlib.Path) -> list[str]:
+  """Problems of the zoo's files against its manifest (missing, differing sha256, unlisted), one
+  line each; empty when every file is intact."""
+  entries = read_manifest(zoo)
+  problems = []
+  for path, entry in sorted(entries.items()):
+    if not (zoo / path).is_file():
+      problems.append(f"{path}: missing")
+    elif file_sha256(zoo / path) != entry.sha256:
+      problems.append(f"{path}: sha256 differs from the manifest's")
+  listed = set(entries) | {MANIFEST}
+  for path in sorted(zoo.rglob("*")):
+    if path.is_file() and path.relative_to(zoo).as_posix() not in listed:
+      problems.append(f"{path.relative_to(zoo).as_posix()}: not in the manifest")
+  return problems

@@ -1,0 +1,118 @@
+"""``softbench zoo verify``: re-scores committed records from the zoo's weights alone, in an
+empty data home, and compares every figure with the record's."""
+
+import contextlib
+import dataclasses
+import json
+import os
+import pathlib
+import tempfile
+import time
+from collections.abc import Iterator
+
+from softbench import continual
+from softbench import profiles
+from softbench import robots
+from softbench import run as run_module
+from softbench import storage
+from softbench import zoo
+from softbench.leaderboard import records
+
+
+@dataclasses.dataclass(frozen=True)
+class Check:
+  """One seed of one record, re-scored from the zoo."""
+
+  record: str
+  seed: int
+  identical: bool
+  detail: str  # What differs, or how the record could not be re-scored; '' when identical.
+  seconds: float
+
+
+@contextlib.contextmanager
+def empty_data_home() -> Iterator[pathlib.Path]:
+  """Within the block the data home is a new empty folder, so that nothing trained or collected
+  before is reused."""
+  previous = os.environ.get(storage.HOME_VARIABLE)
+  with tempfile.TemporaryDirectory(prefix="softbench-zoo-verify-") as home:
+    os.environ[storage.HOME_VARIABLE] = home
+    try:
+      yield pathlib.Path(home)
+    finally:
+      if previous is None:
+        os.environ.pop(storage.HOME_VARIABLE, None)
+      else:
+        os.environ[storage.HOME_VARIABLE] = previous
+
+
+def agent_of(entry: zoo.Entry) -> str:
+  """The agent whose weights ``entry`` holds (an Exp1S network is smpl's)."""
+  return entry.config.get("agent", "smpl")
+
+
+def planned(zoo_folder: pathlib.Path, agents: tuple[str, ...] | None, quick: bool
+            ) -> list[tuple[str, int]]:
+  """(record name, seed) pairs to re-score: every record each agent checkpoint of the zoo stands
+  behind, for the agents named (all if None); ``quick``: seed 0 only, one record each."""
+  pairs = []
+  for entry in zoo.read_manifest(zoo_folder).values():
+    if entry.kind != "agent" or (agents and agent_of(entry) not in agents):
+      continue
+    seed = entry.config.get("seed")
+    if quick and seed != 0:
+      continue
+    names = sorted(entry.records)
+    pairs += [(name, seed) for name in (names[:1] if quick else names)]
+  return sorted(set(pairs))
+
+
+def _rescored(record: dict, seed: int) -> dict:
+  """Seed ``seed``'s entry of ``record`` computed again (in the current data home)."""
+  profile = profiles.get(record["profile"])
+  if record["format"] == continual.RECORD_FORMAT:
+    family = next(name for name in robots.TENDON_FAMILIES
+                  if continual.protocol(name).robot_names == tuple(record["robots"]))
+    with tempfile.TemporaryDirectory() as kept:
+      entry = continual.score_seed(seed, profile, False, pathlib.Path(kept), family)
+  else:
+    module = record["scored_modules"][0] if record["task"] == "reach" else None
+    settings = run_module.settings(record["task"], record["agent"], record["robot"], 1,
+                                   record["profile"], record["eval_mode"], record["trajectory"],
+                                   module)
+    entry = run_module.score_seed(settings, seed)
+  return json.loads(json.dumps(entry))  # As a record stores it.
+
+
+def _difference(new: dict, old: dict) -> str:
+  """Where two seed entries first differ, in one line."""
+  for metric in records.METRICS:
+    if metric in old and new.get(metric, {}).get("mean") != old[metric]["mean"]:
+      return f"{metric} mean {new.get(metric, {}).get('mean')!r} against {old[metric]['mean']!r}"
+  keys = sorted(key for key in old.keys() | new.keys() if new.get(key) != old.get(key))
+  return f"differs in {', '.join(keys)}"
+
+
+def verify(results: pathlib.Path, zoo_folder: pathlib.Path, agents: tuple[str, ...] | None = None,
+           quick: bool = False, report=None) -> list[Check]:
+  """Re-scores ``planned`` records in an empty data home, one seed at a time, and compares each
+  seed's figures with the record's; ``report(check)`` sees each check as it ends."""
+  found = {path.name: record for path, record in records.read_folder(results)}
+  checks = []
+  for name, seed in planned(zoo_folder, agents, quick):
+    started = time.perf_counter()
+    record = found.get(name)
+    stored = None if record is None else next(
+        (entry for entry in record["per_seed"] if entry["seed"] == seed), None)
+    if stored is None:
+      check = Check(name, seed, False, "no such record or seed in " + str(results), 0.0)
+    else:
+      with empty_data_home():
+        new = _rescored(record, seed)
+      identical = new == stored
+      check = Check(name, seed, identical, "" if identical else _difference(new, stored),
+                    time.perf_counter() - started)
+    checks.append(check)
+    if report is not None:
+      report(check)
+  return checks

@@ -1,0 +1,272 @@
+"""The zoo: trained weights taken instead of training, refused when damaged, unfinished trainings
+carried to another data home, and records re-scored from it (``softbench zoo``)."""
+
+import json
+import shutil
+
+import numpy as np
+import pytest
+
+from smpl import training
+from softbench import agents
+from softbench import cli
+from softbench import evaluation
+from softbench import profiles
+from softbench import protocols
+from softbench import suite
+from softbench import zoo
+from softbench.agents import learned
+from softbench.leaderboard import records
+from softbench.zoo import catalogue
+
+LEARNED_AGENTS = [name for name in agents.AGENTS if agents.describe(name).learned]
+ROBOT = "tendon-2"
+TINY = profiles.get("tiny")
+
+
+def actions(agent_name, seed=0):
+  agent = agents.make(agent_name, ROBOT, seed, "tiny")
+  return evaluation.run_episode(suite.load(ROBOT, "circle", seed=seed, length=4), agent,
+                                "circle").actions
+
+
+def use(monkeypatch, home, zoo_folder=None):
+  monkeypatch.setenv("SOFTBENCH_HOME", str(home))
+  monkeypatch.setenv(zoo.VARIABLE, str(zoo_folder) if zoo_folder else zoo.OFF)
+
+
+def no_training(monkeypatch):
+  """Makes any training or babbling collection fail the test."""
+  def refuse(*args, **kwargs):
+    raise AssertionError("trained or collected although the zoo holds the weights")
+  monkeypatch.setattr(training, "fit", refuse)
+  monkeypatch.setattr(protocols, "prepare_column", refuse)
+  monkeypatch.setattr(learned.data, "collect", refuse)
+
+
+@pytest.fixture(scope="module")
+def trained_zoos(tmp_path_factory):
+  """Per learned agent (made on first use): a zoo of its tiny seed-0 weights, trained in a home
+  of its own, and the trained agent's actions."""
+  made = {}
+
+  def get(agent_name):
+    if agent_name not in made:
+      base = tmp_path_factory.mktemp(f"zoo-{agent_name}")
+      with pytest.MonkeyPatch.context() as patched:
+        use(patched, base / "trained")
+        trained = actions(agent_name)
+        chosen = catalogue.setting(agent_name, ROBOT, None, "tiny", 1)
+        zoo.add([(path, kind) for _, path, kind in catalogue.cache_files(chosen)], {},
+                base / "zoo")
+      made[agent_name] = (base / "zoo", trained)
+    return made[agent_name]
+
+  return get
+
+
+@pytest.fixture
+def zoo_of(trained_zoos, tmp_path):
+  """A copy (the test's own) of ``agent_name``'s zoo, and the trained agent's actions."""
+  def copy(agent_name):
+    folder, trained = trained_zoos(agent_name)
+    shutil.copytree(folder, tmp_path / "zoo")
+    return tmp_path / "zoo", trained
+  return copy
+
+
+@pytest.mark.parametrize("agent_name", LEARNED_AGENTS)
+def test_an_empty_data_home_takes_the_zoos_weights_instead_of_training(agent_name, zoo_of,
+                                                                       tmp_path, monkeypatch,
+                                                                       capsys):
+  folder, trained = zoo_of(agent_name)
+  capsys.readouterr()
+  use(monkeypatch, tmp_path / "empty", folder)
+  with monkeypatch.context() as patched:
+    no_training(patched)
+    np.testing.assert_array_equal(actions(agent_name), trained)
+  (line,) = capsys.readouterr().err.splitlines()
+  assert line.startswith("softbench: zoo: took checkpoints/") and "instead of training" in line
+
+
+def test_a_tampered_zoo_file_is_refused_in_one_line_and_the_agent_trained(zoo_of, tmp_path,
+                                                                         monkeypatch):
+  # The zoo checks bytes, whatever the agent: one agent shows it.
+  agent_name = "mlp"
+  folder, trained = zoo_of(agent_name)
+  (checkpoint,) = folder.glob(f"{learned.CHECKPOINT_FOLDER}/{agent_name}-*.pt")
+  content = bytearray(checkpoint.read_bytes())
+  content[len(content) // 2] ^= 1  # One bit of the weights.
+  checkpoint.write_bytes(bytes(content))
+  use(monkeypatch, tmp_path / "empty", folder)
+  with pytest.warns(zoo.ZooWarning) as caught:
+    retrained = actions(agent_name)
+  (warning,) = [entry for entry in caught if issubclass(entry.category, zoo.ZooWarning)]
+  message = str(warning.message)
+  assert str(checkpoint) in message and "tampered" in message and "\n" not in message
+  np.testing.assert_array_equal(retrained, trained)
+
+
+@pytest.mark.parametrize("damage", ["not json", '{"format": "softbench-zoo", "version": 1}',
+                                    '{"format": "other", "version": 1, "entries": []}'])
+def test_a_damaged_manifest_is_one_warning_and_the_agent_trains(damage, zoo_of, tmp_path,
+                                                                monkeypatch):
+  folder, trained = zoo_of("mlp")
+  (folder / zoo.MANIFEST).write_text(damage)
+  use(monkeypatch, tmp_path / "empty", folder)
+  with pytest.warns(zoo.ZooWarning, match="unreadable zoo manifest"):
+    np.testing.assert_array_equal(actions("mlp"), trained)
+
+
+def test_a_manifest_path_outside_the_zoo_is_refused(tmp_path):
+  entry = zoo.Entry("../outside.pt", "0" * 64, 1, "agent", "outside")
+  (tmp_path / zoo.MANIFEST).write_text(json.dumps(
+      {"format": zoo.FORMAT, "version": zoo.VERSION, "entries": [entry.to_json()]}))
+  with pytest.raises(ValueError, match="outside the zoo"):
+    zoo.read_manifest(tmp_path)
+
+
+@pytest.mark.parametrize("agent_name", LEARNED_AGENTS)
+def test_an_unfinished_training_goes_on_from_the_zoo_in_another_home(
+    agent_name, trained_zoos, interrupted_training, tmp_path, monkeypatch, capsys):
+  _, uninterrupted = trained_zoos(agent_name)
+  use(monkeypatch, tmp_path / "first")
+  with interrupted_training():
+    actions(agent_name)
+  chosen = catalogue.setting(agent_name, ROBOT, None, "tiny", 1)
+  files = [(path, kind) for _, path, kind in catalogue.cache_files(chosen)]
+  added = zoo.add([entry for entry in files if entry[0].is_file()
+                   or entry[0].with_suffix(zoo.PARTIAL_SUFFIX).is_dir()], {}, tmp_path / "zoo")
+  assert "training-state" in {entry.kind for entry in added}
+  capsys.readouterr()
+  use(monkeypatch, tmp_path / "second", tmp_path / "zoo")  # Another machine's empty home.
+  np.testing.assert_array_equal(actions(agent_name), uninterrupted)
+  assert "softbench: zoo: resuming the training of" in capsys.readouterr().err
+  # Once finished, its checkpoint replaces the training state in the zoo.
+  zoo.add([(path, kind) for _, path, kind in catalogue.cache_files(chosen)], {}, tmp_path / "zoo")
+  entries = zoo.read_manifest(tmp_path / "zoo")
+  assert {entry.kind for entry in entries.values()} <= {"agent", "forward"}
+  assert not list((tmp_path / "zoo").rglob("*.partial"))
+  assert zoo.check_files(tmp_path / "zoo") == []
+
+
+def test_the_zoo_refuses_to_outgrow_its_budget(zoo_of, tmp_path, monkeypatch):
+  folder, _ = zoo_of("mlp")
+  before = (folder / zoo.MANIFEST).read_bytes()
+  chosen = catalogue.setting("lstm", ROBOT, None, "tiny", 1)
+  use(monkeypatch, tmp_path / "trained")
+  actions("lstm")
+  with pytest.raises(ValueError, match="over its budget"):
+    zoo.add([(path, kind) for _, path, kind in catalogue.cache_files(chosen)], {}, folder,
+            budget_bytes=zoo.size_bytes(zoo.read_manifest(folder)))
+  assert (folder / zoo.MANIFEST).read_bytes() == before
+  assert not list(folder.glob(f"{learned.CHECKPOINT_FOLDER}/lstm-*"))
+
+
+def run_command(results, seeds=2):
+  return ["run", "--task", "spiral", "--agent", "lstm", "--robot", ROBOT, "--profile", "tiny",
+          "--seeds", str(seeds), "--workers", "1", "--results", str(results)]
+
+
+def test_cli_run_add_and_verify_reproduce_a_record_from_the_zoo(tmp_path, monkeypatch, capsys):
+  use(monkeypatch, tmp_path / "trained")
+  assert cli.main(run_command(tmp_path / "results")) == 0
+  ((path, trained),) = records.read_folder(tmp_path / "results")
+  folder = tmp_path / "zoo"
+  assert cli.main(["zoo", "add", "--agent", "lstm", "--robot", ROBOT, "--profile", "tiny",
+                   "--results", str(tmp_path / "results"), "--zoo", str(folder)]) == 0
+  entries = zoo.read_manifest(folder).values()
+  assert {entry.kind for entry in entries} == {"agent", "forward"}
+  assert all(entry.records == (path.name,) for entry in entries if entry.kind == "agent")
+  # A fresh clone: an empty data home re-scores the record without babbling or training.
+  use(monkeypatch, tmp_path / "empty", folder)
+  with monkeypatch.context() as patched:
+    no_training(patched)
+    assert cli.main(run_command(tmp_path / "rescored")) == 0
+  ((_, rescored),) = records.read_folder(tmp_path / "rescored")
+  assert rescored["per_seed"] == trained["per_seed"]
+  assert len(rescored["zoo"]["files"]) == 2 and "zoo" not in trained
+  assert not (tmp_path / "empty" / "datasets").exists()
+  capsys.readouterr()
+  assert cli.main(["zoo", "verify", "--results", str(tmp_path / "results"), "--zoo",
+                   str(folder)]) == 0
+  out = capsys.readouterr().out
+  assert out.count("identical (") == 2 and "2 of 2 re-scored seeds identical" in out
+  assert cli.main(["zoo", "verify", "--quick", "--results", str(tmp_path / "results"), "--zoo",
+                   str(folder)]) == 0
+  assert "1 of 1 re-scored seeds identical" in capsys.readouterr().out
+
+
+def test_verify_reports_a_record_the_zoo_does_not_reproduce(tmp_path, monkeypatch, capsys):
+  use(monkeypatch, tmp_path / "trained")
+  assert cli.main(run_command(tmp_path / "results", seeds=1)) == 0
+  assert cli.main(["zoo", "add", "--agent", "lstm", "--robot", ROBOT, "--profile", "tiny",
+                   "--seeds", "1", "--results", str(tmp_path / "results"), "--zoo",
+                   str(tmp_path / "zoo")]) == 0
+  ((path, record),) = records.read_folder(tmp_path / "results")
+  record["per_seed"][0]["mean_reward"] /= 2  # A record that these weights did not score.
+  records.write({key: value for key, value in record.items() if key != records.INTEGRITY_FIELD},
+                path)
+  capsys.readouterr()
+  assert cli.main(["zoo", "verify", "--results", str(tmp_path / "results"), "--zoo",
+                   str(tmp_path / "zoo")]) == cli.EXIT_FAILURE
+  captured = capsys.readouterr()
+  assert "DIFFERS: differs in mean_reward" in captured.out
+  assert captured.err.strip() == "softbench: error: 1 re-scored seeds differ from their records"
+  # A damaged zoo file is named before anything is re-scored.
+  (checkpoint,) = (tmp_path / "zoo" / learned.CHECKPOINT_FOLDER).glob("*.pt")
+  checkpoint.write_bytes(checkpoint.read_bytes()[:-1])
+  assert cli.main(["zoo", "verify", "--results", str(tmp_path / "results"), "--zoo",
+                   str(tmp_path / "zoo")]) == cli.EXIT_USAGE
+  assert "sha256 differs" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["--agent", "zero", "--robot", ROBOT], "does not learn"),
+    (["--agent", "lstm", "--robot", "tendon-0"], "1 to 10 modules, got 0"),
+    (["--agent", "lstm"], "name the setting"),
+    (["--protocol", "exp1s", "--robot", ROBOT], "drop --robot"),
+    (["--protocol", "exp2s"], "unknown protocol"),
+    (["--family", "tendon-local"], "--family goes with --protocol"),
+    (["--agent", "lstm", "--robot", ROBOT, "--seeds", "0"], "at least 1"),
+    (["--agent", "lstm", "--robot", ROBOT], "neither trained nor being trained"),
+])
+def test_zoo_add_refuses_bad_input_in_one_line(argv, message, tmp_path, monkeypatch, capsys):
+  use(monkeypatch, tmp_path / "home")
+  assert cli.main(["zoo", "add", *argv, "--profile", "tiny", "--zoo",
+                   str(tmp_path / "zoo")]) == cli.EXIT_USAGE
+  error = capsys.readouterr().err
+  assert message in error and error.count("\n") == 1 and error.startswith("softbench: error:")
+  assert not (tmp_path / "zoo" / zoo.MANIFEST).exists()
+
+
+def test_zoo_commands_without_a_zoo_are_one_line_errors(tmp_path, monkeypatch, capsys):
+  use(monkeypatch, tmp_path / "home")
+  for argv in (["zoo", "list"], ["zoo", "verify"], ["zoo", "list", "--zoo", str(tmp_path)]):
+    expected = 0 if "--zoo" in argv else cli.EXIT_USAGE
+    assert cli.main(argv) == expected
+  assert "turned off" in capsys.readouterr().err
+  monkeypatch.setenv(zoo.VARIABLE, str(tmp_path / "missing"))
+  assert cli.main(["zoo", "list"]) == cli.EXIT_USAGE
+  assert "no zoo at" in capsys.readouterr().err
+  assert cli.main(["zoo", "verify", "--agents", "nobody", "--zoo", str(tmp_path)]) == \
+      cli.EXIT_USAGE
+  assert "unknown agent" in capsys.readouterr().err
+
+
+def test_exp1s_networks_come_from_the_zoo(two_stages, tmp_path, monkeypatch, capsys):
+  argv = ["run", "--protocol", "exp1s", "--agent", "smpl", "--profile", "tiny", "--seeds", "1",
+          "--workers", "1"]
+  assert cli.main([*argv, "--results", str(tmp_path / "results")]) == 0
+  ((path, trained),) = [(path, record) for path, record in
+                        records.read_folder(tmp_path / "results")]
+  assert cli.main(["zoo", "add", "--protocol", "exp1s", "--profile", "tiny", "--seeds", "1",
+                   "--results", str(tmp_path / "results"), "--zoo", str(tmp_path / "zoo")]) == 0
+  (entry,) = zoo.read_manifest(tmp_path / "zoo").values()
+  assert entry.kind == "agent" and entry.records == (path.name,)
+  use(monkeypatch, tmp_path / "empty", tmp_path / "zoo")
+  with monkeypatch.context() as patched:
+    no_training(patched)
+    assert cli.main([*argv, "--results", str(tmp_path / "rescored")]) == 0
+  ((_, rescored),) = records.read_folder(tmp_path / "rescored")
+  assert rescored["per_seed"] == trained["per_seed"] and rescored["zoo"]["files"]
