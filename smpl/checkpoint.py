@@ -6,8 +6,9 @@ and a sha256 of the weights and statistics (names, dtypes, shapes, bytes). Files
 atomically, so a crash never leaves a half-written checkpoint under the real name. Loading
 refuses, with a one-line `CheckpointError` naming the file, a file that is not a complete, intact
 checkpoint or whose configuration differs from the one expected, and leaves the model untouched.
-Files written before the hash was added (no `sha256` field) load as before, unverified.
-`load_cached` turns such a refusal into a warning, for a cache that trains the model again.
+Files written before the hash was added (no `sha256` field) load as before, unverified. A cache
+reads its checkpoints through `smpl.files.read_cached`, which turns any refusal into one warning
+and trains the model again.
 """
 
 from __future__ import annotations
@@ -16,9 +17,6 @@ import dataclasses
 import hashlib
 import io
 import os
-import re
-import tempfile
-import warnings
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -27,6 +25,8 @@ import numpy as np
 import torch
 from torch import nn
 
+from smpl.files import first_line, write_atomically  # noqa: F401  (first_line: used widely)
+
 _FORMAT = "softbench-smpl-checkpoint"
 """Marks a file as one of ours."""
 _FORMAT_VERSION = 1
@@ -34,8 +34,6 @@ _FORMAT_VERSION = 1
 _FIELDS = frozenset({"format", "version", "config_type", "config", "state_dict", "normalisation"})
 """The fields of every checkpoint; those written since the hash was added also have `sha256`."""
 _HASH_FIELD = "sha256"
-_ESCAPE_SEQUENCE = re.compile(r"\x1b\[[0-9;]*m")
-"""A terminal colour code, as torch puts in some of its messages."""
 
 
 class CheckpointError(ValueError):
@@ -67,19 +65,10 @@ def save_checkpoint(
 
 
 def save_atomically(path: Path, payload: Any) -> None:
-    """`torch.save(payload)` to `path` through a temporary file in its folder and a rename, so a
-    crash never leaves half a file under the real name."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(handle, "wb") as file:
-            torch.save(payload, file)
-            file.flush()
-            os.fsync(file.fileno())
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
+    """`torch.save(payload)` to `path` through `write_atomically`."""
+    buffer = io.BytesIO()
+    torch.save(payload, buffer)
+    write_atomically(path, buffer.getvalue())
 
 
 def load_checkpoint(
@@ -118,31 +107,6 @@ def load_checkpoint(
     except Exception as error:  # A field of the wrong type or shape: a damaged file.
         raise CheckpointError(f"{path}: malformed checkpoint: {_described(error)}") from error
     return {name: tensor.cpu().numpy() for name, tensor in normalisation.items()}
-
-
-def load_cached(
-    path: str | os.PathLike[str],
-    model: nn.Module,
-    config: Any,
-    category: type[Warning] = RuntimeWarning,
-    map_location: torch.device | None = None,
-) -> dict[str, np.ndarray] | None:
-    """`load_checkpoint` for a cache file that can be made again: None if there is no file, or
-    if it is refused (a one-line warning of `category` names it), for the caller to train the
-    model again and save it over the file. A folder at `path` is a CheckpointError: it is not
-    ours to delete, and the new checkpoint could not be saved there."""
-    path = Path(path)
-    if path.is_dir():
-        raise CheckpointError(
-            f"{path}: a folder where a checkpoint file belongs; move or remove it and run again"
-        )
-    try:
-        return load_checkpoint(path, model, config, map_location)
-    except FileNotFoundError:
-        return None
-    except CheckpointError as error:
-        warnings.warn(f"{error}; training it again", category, stacklevel=2)
-        return None
 
 
 def _checked(
@@ -227,12 +191,6 @@ def _config_differences(stored: dict[str, Any], expected: dict[str, Any]) -> str
         for name in sorted(stored.keys() | expected.keys())
         if stored.get(name, _MISSING) != expected.get(name, _MISSING)
     )
-
-
-def first_line(error: BaseException) -> str:
-    """An exception's message on one line (its first, without terminal colour codes)."""
-    lines = _ESCAPE_SEQUENCE.sub("", str(error)).strip().splitlines()
-    return lines[0].strip() if lines else type(error).__name__
 
 
 def _described(error: BaseException) -> str:

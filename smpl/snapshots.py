@@ -16,14 +16,14 @@ import contextlib
 import contextvars
 import os
 import shutil
-import warnings
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import torch
 
-from smpl.checkpoint import first_line, save_atomically
+from smpl.checkpoint import save_atomically
+from smpl.files import read_cached
 
 SAVE_INTERVAL_S = 30.0
 """Least wall time (s) between two snapshots of a fit under way."""
@@ -68,24 +68,18 @@ def save(path: Path, fingerprint: str, state: dict[str, Any]) -> None:
 
 
 def load(path: Path, fingerprint: str) -> dict[str, Any] | None:
-    """The state saved at `path` for the fit with `fingerprint`, or None (absent, unreadable or
-    another fit's, with a warning for the last two)."""
-    if not path.exists():
-        return None
-    try:
-        payload = torch.load(path, map_location="cpu", weights_only=True)
+    """The state saved at `path` for the fit with `fingerprint`, or None: absent, or unusable
+    (unreadable, or another fit's), which `read_cached` reports in one line and removes."""
+
+    def read(found: Path) -> dict[str, Any]:
+        payload = torch.load(found, map_location="cpu", weights_only=True)
         if payload["format"] != _FORMAT:
             raise ValueError("not a training snapshot")
-        matches = payload["fingerprint"] == fingerprint
-    except Exception as error:  # A damaged file raises nearly anything.
-        warnings.warn(f"{path}: unreadable training snapshot ({first_line(error)}); training "
-                      f"that model from the start", RuntimeWarning, stacklevel=2)
-        return None
-    if not matches:
-        warnings.warn(f"{path}: training snapshot of another config, data or initialisation; "
-                      f"training that model from the start", RuntimeWarning, stacklevel=2)
-        return None
-    return payload["state"]
+        if payload["fingerprint"] != fingerprint:
+            raise ValueError("a snapshot of another config, data or initialisation")
+        return payload["state"]
+
+    return read_cached(path, read, "training snapshot", "training that model from the start")
 
 
 def discard(folder: str | os.PathLike[str]) -> None:

@@ -65,7 +65,7 @@ def _robots(args: argparse.Namespace) -> None:
 
 
 def _models_export(args: argparse.Namespace) -> None:
-  out = pathlib.Path(args.out)
+  out = storage.check_writable(args.out, "models to", folder=True)
   chosen = [robots.make(name) for name in args.robots or robots.BENCHMARK_ROBOTS]  # Checked first.
   for robot in chosen:
     for path in model_export.export(robot, out, args.measure_speed):
@@ -219,7 +219,9 @@ def _write_video(settings: run_module.RunSettings, seed: int, episode, path: pat
 
 def _run(args: argparse.Namespace) -> None:
   if args.video is None and _video_flags_given(args):
-    raise ValueError(f"{', '.join(_video_flags_given(args))} go with --video FILE.mp4")
+    given = _video_flags_given(args)
+    raise ValueError(f"{', '.join(given)} {'goes' if len(given) == 1 else 'go'} with --video "
+                     f"FILE.mp4")
   _check_record_arguments(args)
   if args.workers is not None:  # Before any collection or training starts.
     dataset.check_count("workers", args.workers)
@@ -611,6 +613,9 @@ def _add_zoo_parser(commands) -> None:
   verify_parser.set_defaults(run=_zoo_verify)
 
 
+_CACHING_COMMANDS = ("collect", "run", "render", "retrain", "tune")  # They write to the data home.
+
+
 def main(argv: list[str] | None = None) -> int:
   try:
     args = build_parser().parse_args(argv)
@@ -619,6 +624,8 @@ def main(argv: list[str] | None = None) -> int:
   run_module.one_line_warnings()
   try:
     with run_module.sigterm_as_interrupt():
+      if args.command in _CACHING_COMMANDS:  # Before any work: a home that takes no file fails
+        storage.check_home()  # at once, not after the first seed.
       args.run(args)
   except (ValueError, FileNotFoundError, FloatingPointError, video.RenderingUnavailable) as error:
     print(f"softbench: error: {dataset.first_line(error)}", file=sys.stderr)

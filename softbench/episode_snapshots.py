@@ -26,6 +26,7 @@ import softbench
 from smpl import training
 from softbench import evaluation
 from softbench import storage
+from softbench.data import dataset
 
 FOLDER = "runs"
 _ARRAYS = ("targets", "achieved", "poses", "actions", "rewards")
@@ -92,38 +93,40 @@ def _keep(path: pathlib.Path, content: bytes | str, subject: str, what: str) -> 
                   f"({error.strerror or error}); the run goes on without it")
 
 
-def _discard_damaged(path: pathlib.Path, subject: str, what: str, error: Exception) -> None:
-  warnings.warn(f"discarding the saved {what} {path} ({type(error).__name__}: {error}); "
-                f"{subject} runs again")
-  path.unlink(missing_ok=True)
+def _owner(path: pathlib.Path) -> str:
+  """What a saved file belongs to: its place in the data home (run key, seed, episode), stored
+  in it and hashed with it, so that a file copied from another run or seed is refused."""
+  return path.relative_to(storage.softbench_home()).as_posix()
+
+
+def _check_owner(stored: str, path: pathlib.Path) -> None:
+  if stored != _owner(path):
+    raise ValueError(f"saved for {stored}, not for this run and seed")
 
 
 def save(run, seed: int, episode: evaluation.Episode) -> None:
   """Keeps ``seed``'s finished ``episode`` until the run ends (a failed write only warns)."""
   arrays = {name: np.asarray(getattr(episode, name)) for name in _ARRAYS}
   arrays["scored_modules"] = np.asarray(episode.scored_modules, dtype=int)
+  arrays["owner"] = np.asarray(_owner(_path(run, seed)))
   arrays["sha256"] = np.asarray(storage.arrays_sha256(arrays))
   _keep(_path(run, seed), storage.npz_bytes(arrays), f"seed {seed}", "episode")
 
 
 def load(run, seed: int) -> evaluation.Episode | None:
   """``seed``'s episode saved by an interrupted run of the same settings and code, or None. An
-  unreadable or altered file is deleted with a warning (the seed then runs again)."""
-  path = _path(run, seed)
-  if not path.exists():
-    return None
-  try:
-    with np.load(path) as file:
-      arrays = {name: file[name] for name in file.files}
+  unreadable or altered file is deleted with a warning (``storage.read_cached``; the seed then
+  runs again)."""
+  def read(path: pathlib.Path) -> evaluation.Episode:
+    arrays = dataset.read_npz(path.read_bytes(), ValueError)
     expected = str(arrays.pop("sha256"))
     if expected != storage.arrays_sha256(arrays):
       raise ValueError("content hash mismatch")
-    episode = evaluation.Episode(run.task, tuple(int(k) for k in arrays["scored_modules"]),
-                                 *(arrays[name] for name in _ARRAYS))
-  except Exception as error:  # Truncated, corrupt or altered: run the seed again.
-    _discard_damaged(path, f"seed {seed}", "episode", error)
-    return None
-  return episode
+    _check_owner(str(arrays.pop("owner")), path)
+    return evaluation.Episode(run.task, tuple(int(k) for k in arrays["scored_modules"]),
+                              *(arrays[name] for name in _ARRAYS))
+
+  return storage.read_cached(_path(run, seed), read, "saved episode", f"seed {seed} runs again")
 
 
 def _scores_sha256(scores: dict) -> str:
@@ -133,23 +136,24 @@ def _scores_sha256(scores: dict) -> str:
 def save_scores(path: pathlib.Path, scores: dict, subject: str) -> None:
   """Keeps the finished ``scores`` (JSON-serialisable) of ``subject`` (a seed, an episode) at
   ``path`` until the run ends (a failed write only warns)."""
-  text = json.dumps({"scores": scores, "sha256": _scores_sha256(scores)})
+  owned = {"scores": scores, "owner": _owner(path)}
+  text = json.dumps({**owned, "sha256": _scores_sha256(owned)})
   _keep(path, text, subject, "scores")
 
 
 def load_scores(path: pathlib.Path, subject: str) -> dict | None:
   """The scores of ``subject`` that an interrupted run saved at ``path``, or None; an unreadable
-  or altered file is deleted with a warning (``subject`` then runs again)."""
-  if not path.exists():
-    return None
-  try:
-    saved = json.loads(path.read_text())
-    if saved["sha256"] != _scores_sha256(saved["scores"]):
+  or altered file is deleted with a warning (``storage.read_cached``; ``subject`` then runs
+  again)."""
+  def read(found: pathlib.Path) -> dict:
+    saved = json.loads(found.read_text())
+    owned = {"scores": saved["scores"], "owner": saved["owner"]}
+    if saved["sha256"] != _scores_sha256(owned):
       raise ValueError("content hash mismatch")
-  except Exception as error:  # Truncated, corrupt or altered: run it again.
-    _discard_damaged(path, subject, "scores", error)
-    return None
-  return saved["scores"]
+    _check_owner(saved["owner"], found)
+    return saved["scores"]
+
+  return storage.read_cached(path, read, "saved scores", f"{subject} runs again")
 
 
 def discard(run) -> None:

@@ -31,7 +31,7 @@ def main(argv: list[str] | None = None) -> int:
   except (ImportError, AttributeError, RuntimeError, OSError) as error:
     backend = os.environ.get("MUJOCO_GL")
     failures = [entry for entry in [os.environ.get(FAILED_BACKENDS_VARIABLE)] if entry]
-    from smpl.checkpoint import first_line  # pylint: disable=import-outside-toplevel
+    from smpl.files import first_line  # pylint: disable=import-outside-toplevel
     failures.append(f"MUJOCO_GL={backend!r}: {type(error).__name__}: {first_line(error)}")
     fallback = _fallback(backend) if softbench.AUTOMATIC_GL_BACKEND == backend else None
     if fallback is not None:

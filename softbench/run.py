@@ -241,12 +241,13 @@ def _run_seed(seed: int, run: RunSettings,
   """The episode of ``seed`` (``seed_episode``, or the one an interrupted run of the same
   settings and code saved) and its record entry; a new episode is saved at once."""
   episode = episode_snapshots.load(run, seed)
-  if episode is None:
-    episode, arm = _episode_and_arm(run, seed, show_progress)
-    episode_snapshots.save(run, seed, episode)
-  else:
-    arm = robots.make(run.robot).with_faults(run.faults)
-  return seed_entry(seed, episode, arm), episode
+  if episode is not None:
+    return seed_entry(seed, episode, robots.make(run.robot).with_faults(run.faults)), episode
+  episode, arm = _episode_and_arm(run, seed, show_progress)
+  entry = seed_entry(seed, episode, arm)
+  records.check_finite(entry, f"seed {seed}'s scores")  # Kept only if a record can hold it.
+  episode_snapshots.save(run, seed, episode)
+  return entry, episode
 
 
 def one_line_warnings() -> None:

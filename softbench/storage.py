@@ -10,10 +10,25 @@ import io
 import os
 import pathlib
 import tempfile
+import warnings
 
 import numpy as np
 
+from smpl import files
+from smpl.files import CorruptFileWarning, discard, first_line, read_cached  # noqa: F401
+
 HOME_VARIABLE = "SOFTBENCH_HOME"
+
+
+def write_cache_file(path: pathlib.Path, content: str | bytes, what: str) -> None:
+  """``write_atomically`` for a cache file: anything but a file standing at ``path`` (a folder)
+  is damage, as for ``read_cached``: reported, removed, and the file written in its place."""
+  path = pathlib.Path(path)
+  if os.path.lexists(path) and not path.is_file():
+    warnings.warn(f"{path}: not a file where the {what} belongs; removing it", CorruptFileWarning,
+                  stacklevel=2)
+    discard(path)
+  write_atomically(path, content)
 
 
 def softbench_home() -> pathlib.Path:
@@ -24,28 +39,12 @@ def softbench_home() -> pathlib.Path:
   return pathlib.Path(cache) / "softbench"
 
 
-_FILE_MODE = 0o666  # What open() requests for a new file.
-
-
 def write_atomically(path: pathlib.Path, content: str | bytes) -> None:
-  """Writes ``content`` (text or bytes) to ``path`` through a temporary file and a rename.
-
-  The file gets the permissions a plain ``open`` would give (0666 less the umask), not the
-  owner-only mode of the temporary file. A failed write (a full disk, ``path`` a folder) removes
-  the temporary file and raises its error."""
-  path = pathlib.Path(path)
-  path.parent.mkdir(parents=True, exist_ok=True)
-  handle, temporary = tempfile.mkstemp(suffix=".tmp", dir=path.parent)
-  try:
-    with os.fdopen(handle, "wb" if isinstance(content, bytes) else "w") as file:
-      file.write(content)
-      file.flush()
-      os.fsync(file.fileno())
-    os.chmod(temporary, _FILE_MODE & ~_umask())
-    os.replace(temporary, path)
-  except BaseException:
-    pathlib.Path(temporary).unlink(missing_ok=True)
-    raise
+  """Writes ``content`` (text or bytes) to ``path`` through a temporary file and a rename, with
+  the permissions of a plain ``open``; the one atomic writer of softbench and smpl
+  (``smpl.files.write_atomically``). A failed write removes the temporary file and raises
+  its error, naming ``path`` (a full disk says which file it could not write)."""
+  files.write_atomically(path, content)
 
 
 def check_writable(path: str | os.PathLike, what: str, folder: bool = False) -> pathlib.Path:
@@ -71,13 +70,22 @@ def check_writable(path: str | os.PathLike, what: str, folder: bool = False) -> 
                      f"{str(ancestor)!r}")
   if not folder and path.exists() and not os.access(path, os.W_OK):
     raise ValueError(f"cannot write {what} {str(path)!r}: the file is read-only")
+  try:  # The permission bits do not tell a read-only mount or /proc (nor anything to root).
+    with tempfile.TemporaryFile(dir=ancestor):
+      pass
+  except OSError as error:
+    raise ValueError(f"cannot write {what} {str(path)!r}: {str(ancestor)!r} takes no new file "
+                     f"({error.strerror or first_line(error)})") from None
   return path
 
 
-def _umask() -> int:
-  current = os.umask(0)
-  os.umask(current)
-  return current
+def check_home() -> pathlib.Path:
+  """The data home, once it is known to take files; checked before any work that caches.
+
+  Raises:
+    ValueError: the data home is a file, lies under one, or cannot be written (one line).
+  """
+  return check_writable(softbench_home(), f"the data home (${HOME_VARIABLE})", folder=True)
 
 
 def arrays_sha256(arrays: dict[str, np.ndarray]) -> str:

@@ -176,7 +176,7 @@ def test_damaged_saved_exp1s_scores_run_again(two_stages, monkeypatch):
   expected = continual.run_seed(0, tiny)
   path = continual.finished_seeds_folder(tiny) / "seed0.json"
   path.write_text(path.read_text().replace('"seed": 0', '"seed": 7'))
-  with pytest.warns(UserWarning, match="discarding the saved scores"):
+  with pytest.warns(UserWarning, match="unreadable saved scores"):
     assert continual.run_seed(0, tiny) == expected
   assert json.loads(path.read_text())["scores"] == expected  # Saved again.
   # With the seed's file gone, a damaged episode's file runs that episode alone again.
@@ -187,6 +187,6 @@ def test_damaged_saved_exp1s_scores_run_again(two_stages, monkeypatch):
   ran, run_episode = [], continual.evaluation.run_episode
   monkeypatch.setattr(continual.evaluation, "run_episode",
                       lambda *arguments: ran.append(arguments[2]) or run_episode(*arguments))
-  with pytest.warns(UserWarning, match="discarding the saved scores .*configuration2-closed"):
+  with pytest.warns(UserWarning, match="configuration2-closed.*unreadable saved scores"):
     assert continual.run_seed(0, tiny) == expected
   assert ran == ["spiral"]

@@ -13,6 +13,7 @@ import pytest
 import torch
 
 from smpl import windows as smpl_windows
+from softbench import agents
 from softbench import data
 from softbench import robots
 from softbench import storage
@@ -69,8 +70,8 @@ def interrupt_after(monkeypatch, chunk_count: int) -> None:
   write = chunks.write
   written = []
 
-  def write_then_interrupt(folder, chunk):
-    write(folder, chunk)
+  def write_then_interrupt(folder, chunk, collection):
+    write(folder, chunk, collection)
     written.append(chunk)
     if len(written) == chunk_count:
       raise KeyboardInterrupt
@@ -177,6 +178,38 @@ def test_corrupt_chunk_is_reported_and_recomputed(monkeypatch, reference_bytes, 
     resumed = collect()
   assert resumed.collection["resumed_from_step"] == CHUNK
   assert npz_bytes(resumed) == reference_bytes
+
+
+def test_a_chunk_of_another_collection_is_refused(monkeypatch, reference_bytes):
+  # A valid chunk of the seed-4 collection, copied into the seed-3 collection's folder: its
+  # poses would go with the wrong actions, so it is reported and recomputed.
+  with monkeypatch.context() as patch:
+    interrupt_after(patch, chunk_count=1)
+    with pytest.raises(KeyboardInterrupt):
+      collect(seed=4)
+  foreign_config = data.generating_config(SMALL["robot"], SMALL["samples"], 4,
+                                          SMALL["episode_length"])
+  (foreign,) = (dataset.dataset_folder(foreign_config) / chunks.PARTIAL_FOLDER).iterdir()
+  partial_folder(small_config()).mkdir(parents=True)
+  (partial_folder(small_config()) / foreign.name).write_bytes(foreign.read_bytes())
+  with pytest.warns(dataset.CorruptFileWarning, match="a chunk of another collection"):
+    resumed = collect()
+  assert resumed.collection["resumed_from_step"] == 0
+  assert npz_bytes(resumed) == reference_bytes
+
+
+@pytest.mark.parametrize("manifest", [True, False])
+def test_a_folder_where_the_dataset_file_belongs_is_replaced(manifest, reference_bytes):
+  # It once broke every collection until removed by hand.
+  folder = dataset.dataset_folder(small_config())
+  if manifest:
+    collect()
+  (folder / dataset.NPZ_NAME).unlink(missing_ok=True)
+  (folder / dataset.NPZ_NAME / "stray").mkdir(parents=True)
+  with pytest.warns(dataset.CorruptFileWarning) as caught:
+    collected = collect()
+  assert len(caught) == 1 and str(folder / dataset.NPZ_NAME) in str(caught[0].message)
+  assert npz_bytes(collected) == reference_bytes
 
 
 def test_resuming_with_another_chunk_length_gives_identical_bytes(monkeypatch, reference_bytes):
@@ -439,6 +472,27 @@ def test_atomic_writes_get_the_permissions_of_a_plain_open(tmp_path):
   storage.write_atomically(atomic, "x")
   assert atomic.stat().st_mode == plain.stat().st_mode
   assert not list(tmp_path.glob("*.tmp"))
+
+
+def test_every_cache_file_gets_the_permissions_of_a_plain_open(tmp_path, monkeypatch):
+  # Checkpoints, forward models and training snapshots were 0600 while datasets were 0644, so a
+  # colleague sharing a data home could not read them.
+  monkeypatch.setenv(storage.HOME_VARIABLE, str(tmp_path / "home"))
+  plain = tmp_path / "plain.txt"
+  plain.write_text("x")
+  agents.make("mlp", "tendon-1", 0, "tiny")
+  files = [path for path in (tmp_path / "home").rglob("*") if path.is_file()]
+  assert {"checkpoints", "forward", "datasets"} <= {path.relative_to(tmp_path / "home").parts[0]
+                                                     for path in files}
+  assert {path.stat().st_mode for path in files} == {plain.stat().st_mode}
+
+
+def test_a_full_disk_names_the_file_it_could_not_write(tmp_path, monkeypatch):
+  monkeypatch.setattr(storage.os, "fsync", _full_disk)
+  with pytest.raises(OSError) as caught:
+    storage.write_atomically(tmp_path / "record.json", "{}")
+  assert caught.value.filename == str(tmp_path / "record.json")
+  assert caught.value.strerror == "No space left on device"
 
 
 def _full_disk(descriptor):

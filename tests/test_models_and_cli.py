@@ -12,7 +12,10 @@ import pytest
 
 import softbench
 from softbench import cli
+from softbench import data
 from softbench import robots
+from softbench import run
+from softbench import storage
 from softbench import suite
 from softbench.robots import export
 from softbench.robots.physics import SoftArmPhysics
@@ -183,3 +186,40 @@ def test_a_closed_pipe_is_not_a_traceback(monkeypatch):
   with os.fdopen(write_end, "w", buffering=1) as closed:
     monkeypatch.setattr(sys, "stdout", closed)
     assert cli.main(["robots"]) == cli.EXIT_FAILURE
+
+
+def _read_only_file_system(*args, **kwargs):
+  raise OSError(30, "Read-only file system")
+
+
+@pytest.mark.parametrize("home", ["/dev/null", "under-a-file", "/proc/softbench", "read-only"])
+@pytest.mark.parametrize("command", [
+    ["run", "--task", "circle", "--agent", "zero", "--robot", "tendon-1", "--profile", "tiny"],
+    ["collect", "--robot", "tendon-1", "--samples", "10"],
+    ["render", "--task", "circle", "--agent", "zero", "--robot", "tendon-1", "--out", "x.mp4"]])
+def test_a_data_home_that_takes_no_file_is_refused_before_any_work(home, command, tmp_path,
+                                                                   monkeypatch, capsys):
+  if home == "under-a-file":
+    (tmp_path / "file").write_text("")
+    home = str(tmp_path / "file" / "home")
+  elif home == "read-only":
+    home = str(tmp_path / "home")
+    monkeypatch.setattr(storage.tempfile, "TemporaryFile", _read_only_file_system)
+  monkeypatch.setenv(storage.HOME_VARIABLE, home)
+  for name in ("execute_episodes", "seed_episode"):
+    monkeypatch.setattr(run, name, _read_only_file_system)  # No work may start.
+  monkeypatch.setattr(data, "collect", _read_only_file_system)
+  results = ["--results", str(tmp_path / "results")] if command[0] == "run" else []
+  assert cli.main([*command, *results]) == cli.EXIT_USAGE
+  error = capsys.readouterr().err
+  assert error.startswith("softbench: error: cannot write the data home") and error.count("\n") == 1
+
+
+@pytest.mark.parametrize("argv", [["models", "export", "--out", "/etc/hostname"],
+                                  ["run", "--task", "circle", "--agent", "zero", "--robot",
+                                   "tendon-1", "--profile", "tiny", "--results", "/proc/results"]])
+def test_outputs_that_take_no_file_are_refused_before_any_work(argv, monkeypatch, capsys):
+  monkeypatch.setattr(run, "execute_episodes", _read_only_file_system)
+  assert cli.main(argv) == cli.EXIT_USAGE
+  error = capsys.readouterr().err
+  assert error.startswith("softbench: error: cannot write") and error.count("\n") == 1

@@ -66,9 +66,23 @@ def test_a_damaged_saved_seed_runs_again(monkeypatch):
   interrupted_at(1, monkeypatch)
   saved = episode_snapshots.folder(tiny_run()) / "seed0.npz"
   saved.write_bytes(saved.read_bytes()[:-100])
-  with pytest.warns(UserWarning, match="discarding the saved episode"):
+  with pytest.warns(UserWarning, match="unreadable saved episode"):
     _, started = seeds_run(monkeypatch)
   assert started == [0, 1, 2]
+
+
+def test_a_saved_seed_of_another_seed_or_run_is_refused(monkeypatch, tmp_path):
+  interrupted_at(1, monkeypatch)  # Seed 0 finished.
+  folder = episode_snapshots.folder(tiny_run())
+  (folder / "seed1.npz").write_bytes((folder / "seed0.npz").read_bytes())  # Intact, misplaced.
+  other = episode_snapshots.folder(tiny_run("zero"))
+  other.mkdir(parents=True)
+  (other / "seed0.npz").write_bytes((folder / "seed0.npz").read_bytes())
+  with pytest.warns(UserWarning, match="seed1.npz: unreadable saved episode .*not for this run"):
+    _, started = seeds_run(monkeypatch)
+  assert started == [1, 2]
+  with pytest.warns(UserWarning, match="seed0.npz: unreadable saved episode .*not for this run"):
+    episode_snapshots.load(tiny_run("zero"), 0)
 
 
 def test_a_failed_save_warns_and_the_run_goes_on(monkeypatch):

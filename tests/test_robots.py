@@ -314,12 +314,21 @@ def test_a_one_module_local_arm_is_the_one_module_arm():
     ("tendon-3", {"no_such_field": 1}),
     ("tendon-3", {"backbone": "spring"}),
     ("pneumatic-433", {"no_such_field": 1}),
-], ids=lambda value: repr(value) if isinstance(value, dict) else value)
+    # Canonical ASCII names only: each of these once built another robot, or Python's message.
+    ("tendon-\uff13", {}),  # Full-width 3.
+    ("tendon-\u0662", {}),  # Arabic-Indic 2.
+    ("tendon-3\n", {}),
+    (" tendon-3", {}),
+    ("tendon-0003", {}),
+    ("tendon-" + "9" * 5000, {}),
+    ("tendon-1", {"num_modules": 0}),  # The name gives the count.
+    ("tendon-1", {"num_modules": 2}),
+], ids=lambda value: repr(value)[:40])
 def test_bad_robot_raises_one_line_value_error(name, overrides):
   with pytest.raises(ValueError) as caught:
     make(name, **overrides)
   message = str(caught.value)
-  assert message.strip() and "\n" not in message
+  assert message.strip() and "\n" not in message and len(message) < 200
 
 
 @pytest.mark.parametrize("robot_name", _robots())
@@ -339,7 +348,7 @@ def test_set_action_rejects_bad_actions(robot_name):
   low = valid.copy()
   low[-1] = -1.5
   for bad in (nan, inf, high, low, np.zeros(dim + 1), np.zeros(dim - 1), np.zeros((1, dim)),
-              np.float64(0.0)):
+              np.float64(0.0), valid + 0.1j, np.ones(dim, dtype=bool), np.array(["0.5"] * dim)):
     with pytest.raises(ValueError) as caught:
       physics.set_action(bad)
     assert "\n" not in str(caught.value)

@@ -12,6 +12,9 @@ import numpy as np
 import pytest
 from dm_env import specs
 
+from softbench import agents
+from softbench import cli
+from softbench import data
 from softbench import robots
 from softbench import run
 from softbench import suite
@@ -260,6 +263,8 @@ class TestCustomTrajectory:
       (lambda rows: rows[:0], "no rows"),
       (lambda rows: np.where(np.arange(12) == 2, np.nan, rows), "NaN"),
       (lambda rows: rows * 2, "unit length"),
+      (lambda rows: np.where(np.arange(12) < 3, 1e300, rows), "arm lengths"),
+      (lambda rows: np.where(np.arange(12) == 2, -0.5, rows), "arm lengths"),  # 500 mm, 100 long.
   ])
   def test_malformed_trajectory_gets_a_clear_error(self, rows, change, message):
     with pytest.raises(ValueError, match=message):
@@ -304,3 +309,29 @@ def test_registry_lists():
   assert len(suite.ALL_TASKS) == len(robots.BENCHMARK_ROBOTS) * 5
   assert set(suite.BENCHMARKING) <= set(suite.ALL_TASKS)
   assert ("tendon-3", "spiral") in suite.BENCHMARKING
+
+
+BAD_SEEDS = [2**32, 2**70, -1, "x", 1.5, True]
+
+
+@pytest.mark.parametrize("seed", BAD_SEEDS, ids=repr)
+@pytest.mark.parametrize("entry", ["suite.load", "data.collect", "agents.make"])
+def test_one_seed_rule_everywhere(entry, seed, monkeypatch, tmp_path):
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
+  calls = {"suite.load": lambda: suite.load("tendon-1", "circle", seed=seed, length=3),
+           "data.collect": lambda: data.collect("tendon-1", samples=4, seed=seed,
+                                                progress=False),
+           "agents.make": lambda: agents.make("zero", "tendon-1", seed)}
+  with pytest.raises(ValueError, match=r"^seed must be an integer from 0 to 4294967295, got "):
+    calls[entry]()
+  assert not (tmp_path / "datasets").exists()
+
+
+@pytest.mark.parametrize("command", [["collect", "--robot", "tendon-1", "--seed"],
+                                     ["render", "--task", "circle", "--agent", "zero", "--robot",
+                                      "tendon-1", "--out", "never.mp4", "--seed"]])
+def test_the_cli_takes_seeds_by_the_same_rule(command, capsys, tmp_path, monkeypatch):
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
+  assert cli.main([*command, str(2**70)]) == cli.EXIT_USAGE
+  assert capsys.readouterr().err == ("softbench: error: seed must be an integer from 0 to "
+                                     f"4294967295, got {2**70}\n")

@@ -139,10 +139,11 @@ def retrain_column(agent: learned.LearnedAgent, faulty_robot: robot_base.SoftArm
   forwards = [copy.deepcopy(controller.forward).freeze() for controller in agent.controllers]
   bundle = torch.nn.ModuleDict({"inverse": inverse,
                                 "forward_models": torch.nn.ModuleList(forwards)})
-  # A damaged cached file is reported (data.CorruptFileWarning) and trained again; a refused file
+  # A damaged cached file is reported (storage.read_cached) and trained again; a refused file
   # leaves the bundle untouched, so the retraining starts from the healthy weights.
-  trained_now = not path.exists() or checkpoint.load_cached(
-      path, bundle, config, data.CorruptFileWarning) is None
+  trained_now = storage.read_cached(
+      path, lambda found: checkpoint.load_checkpoint(found, bundle, config), "retrained column",
+      "training it again") is None
   if trained_now:
     dataset = data.collect(faulty_robot, samples=profile.samples, seed=learned.DATA_SEED,
                            progress=show_progress)

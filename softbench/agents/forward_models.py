@@ -80,7 +80,8 @@ def prepare(robot: robot_base.SoftArm, views: list[data.View], dataset: data.Dat
     path = cache_file(key)
     partial = path.with_suffix(".partial")  # Its training snapshots until it is saved.
     zoo.restore(path)
-    cached = _load(path, key, dataset, view) if path.exists() else None
+    cached = storage.read_cached(path, lambda found: _load(found, key, dataset, view),
+                                 "forward model", "training it again")
     if cached:
       split, model = cached
     else:
@@ -98,11 +99,10 @@ def prepare(robot: robot_base.SoftArm, views: list[data.View], dataset: data.Dat
 
 
 def _load(path: pathlib.Path, key: ForwardModelConfig, dataset: data.Dataset, view: data.View
-          ) -> tuple[data.SplitWindows, smpl_forward.ForwardModel] | None:
-  """The view's windows and the frozen forward model cached at ``path``, or None if the file
-  fails its checks (reported with a ``data.CorruptFileWarning``, for training it again)."""
+          ) -> tuple[data.SplitWindows, smpl_forward.ForwardModel]:
+  """The view's windows and the frozen forward model cached at ``path``; raises if the file
+  fails its checks."""
   split = data.windows(dataset, view)
   model = smpl_forward.ForwardModel(split.train.actuation_size, split.train.pose_size)
-  if checkpoint.load_cached(path, model, key, data.CorruptFileWarning) is None:
-    return None
+  checkpoint.load_checkpoint(path, model, key)
   return split, model.freeze()

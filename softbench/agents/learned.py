@@ -36,7 +36,6 @@ import contextlib
 import dataclasses
 import hashlib
 import pathlib
-import warnings
 from typing import Callable
 
 import numpy as np
@@ -412,30 +411,27 @@ def load_or_train(path: pathlib.Path, config, parts: list[str],
                   untrained_models: Callable[[], tuple[InverseModel,
                                                        list[smpl_forward.ForwardModel]]],
                   train: Callable[[], TrainedModels]) -> TrainedModels:
-  """The models of the checkpoint at ``path`` (saved for ``config``) when it exists, or the zoo
-  holds it (``softbench.zoo``), and it passes its checks, loaded into ``untrained_models()``. Otherwise ``train()``'s (a damaged checkpoint is
-  reported with a ``data.CorruptFileWarning``), trained so that an interrupted training resumes
+  """The models of the checkpoint at ``path`` (saved for ``config``; taken from the zoo if the
+  data home lacks it, ``softbench.zoo``), loaded into ``untrained_models()``. Otherwise, or if
+  the file is damaged in any way (``storage.read_cached``: one ``CorruptFileWarning``),
+  ``train()``'s, trained so that an interrupted training resumes
   (snapshots in ``snapshot_folder(path)``) and then saved there: normalisation i as
   ``parts[i]/KEY``, the further arrays under their own names (no part's prefix)."""
-  stored = None
   zoo.restore(path)
-  if path.exists():
+
+  def read(found: pathlib.Path) -> TrainedModels:
     inverse, forwards = untrained_models()
-    stored = checkpoint.load_cached(path, bundle(inverse, forwards), config,
-                                    data.CorruptFileWarning)
-  if stored is not None:
-    try:
-      normalisations = [data.Normalisation.from_arrays(
-          {key.removeprefix(f"{part}/"): value for key, value in stored.items()
-           if key.startswith(f"{part}/")}) for part in parts]
-    except (KeyError, ValueError, TypeError) as error:  # Damaged where no hash checks it (a file
-      # written before checkpoints had one): train again.
-      warnings.warn(f"{path}: normalisation unusable ({checkpoint.first_line(error)}); training "
-                    "it again", data.CorruptFileWarning, stacklevel=2)
-    else:
-      arrays = {key: np.asarray(value) for key, value in stored.items()
-                if key.split("/")[0] not in parts}
-      return TrainedModels(inverse, forwards, normalisations, arrays)
+    stored = checkpoint.load_checkpoint(found, bundle(inverse, forwards), config)
+    normalisations = [data.Normalisation.from_arrays(
+        {key.removeprefix(f"{part}/"): value for key, value in stored.items()
+         if key.startswith(f"{part}/")}) for part in parts]
+    arrays = {key: np.asarray(value) for key, value in stored.items()
+              if key.split("/")[0] not in parts}
+    return TrainedModels(inverse, forwards, normalisations, arrays)
+
+  cached = storage.read_cached(path, read, "checkpoint", "training it again")
+  if cached is not None:
+    return cached
   with snapshots.resumable(snapshot_folder(path)):
     models = train()
   if set(key.split("/")[0] for key in models.arrays) & set(parts):

@@ -14,12 +14,12 @@ import os
 import pathlib
 import shutil
 import time
-import warnings
 from collections.abc import Sequence
 
 import numpy as np
 
 from softbench import robots
+from softbench import storage
 from softbench.data import chunks
 from softbench.data import dataset
 from softbench.data import progress as progress_bars
@@ -64,17 +64,16 @@ def collect(robot: str | robots.SoftArm, samples: int = dataset.DEFAULT_SAMPLES,
   dataset.check_count("workers", workers)
   dataset.check_count("chunk_length", chunk_length)
   folder = dataset.dataset_folder(config, home)
-  if (folder / dataset.JSON_NAME).exists():
-    try:
-      return dataset.read(folder, config)
-    except dataset.DatasetError as error:
-      warnings.warn(f"{error}; collecting it again", dataset.CorruptFileWarning, stacklevel=2)
+  found = storage.read_cached(folder / dataset.JSON_NAME, lambda _: dataset.read(folder, config),
+                              "dataset", "collecting it again", (folder / dataset.NPZ_NAME,))
+  if found is not None:
+    return found
   started = time.perf_counter()
   lengths = config["episode_lengths"]
   actions = babbling_actions(arm, seed, lengths)
   pose_recorder = recorder.PoseRecorder(arm, min(workers, len(lengths)))
   resumed_step, poses_after = _record(pose_recorder, actions, folder / chunks.PARTIAL_FOLDER,
-                                      chunk_length, progress)
+                                      chunk_length, progress, dataset.dataset_key(config))
   rest_poses = pose_recorder.poses(pose_recorder.rest_state())
   poses = [np.concatenate([rest_poses[None], poses_after[episode, :length]])
            for episode, length in enumerate(lengths)]
@@ -89,9 +88,10 @@ def collect(robot: str | robots.SoftArm, samples: int = dataset.DEFAULT_SAMPLES,
 
 
 def _record(pose_recorder: recorder.PoseRecorder, actions: list[np.ndarray],
-            partial: pathlib.Path, chunk_length: int, show_progress: bool
+            partial: pathlib.Path, chunk_length: int, show_progress: bool, collection: str
             ) -> tuple[int, np.ndarray]:
-  """Records every episode chunk by chunk, from the saved chunks on.
+  """Records every episode chunk by chunk, from the saved chunks of this ``collection`` (its
+  dataset key) on.
 
   Episodes shorter than the longest are held at zero action to its end; those poses are
   dropped. Returns the step resumed from and the poses after each step,
@@ -103,7 +103,7 @@ def _record(pose_recorder: recorder.PoseRecorder, actions: list[np.ndarray],
     held[episode, :len(episode_actions)] = episode_actions
   layout = chunks.Layout(episodes=len(actions), steps=held.shape[1],
                          num_modules=pose_recorder.robot.num_modules,
-                         state_size=pose_recorder.state_size)
+                         state_size=pose_recorder.state_size, collection=collection)
   done = chunks.resume(partial, layout)
   step = done[-1].stop if done else 0
   resumed_step = step
@@ -124,6 +124,6 @@ def _record(pose_recorder: recorder.PoseRecorder, actions: list[np.ndarray],
       stop = min(start + chunk_length, layout.steps)
       poses, states = pose_recorder.record(held[:, start:stop], states, on_step=on_step)
       chunk = chunks.Chunk(start, stop, poses[:, 1:], states)
-      chunks.write(partial, chunk)
+      chunks.write(partial, chunk, collection)
       done.append(chunk)
   return resumed_step, np.concatenate([chunk.poses for chunk in done], axis=1)

@@ -4,14 +4,16 @@ Chunk files live in ``<dataset folder>/partial/``, one per stretch ``[start, sto
 steps, named ``chunk-{start:06d}-{stop:06d}.npz``. Each holds, for every episode, the poses after
 each of those steps (``poses``, (episodes, stop - start, num_modules, 6)), the full physics states
 after the last one (``final_states``, from which ``PoseRecorder`` continues bit for bit), the step
-range (``steps``) and the sha256 of all three (``sha256``, by ``storage.arrays_sha256``). Files
+range (``steps``), the key of the collection it belongs to (``collection``: a chunk copied from
+another collection is refused) and the sha256 of all four (``sha256``, by
+``storage.arrays_sha256``). Files
 are written atomically. A chunk is used only if it reads back whole, fits the collection and
-matches its hash; otherwise it is reported (``CorruptFileWarning``), deleted and computed again.
+matches its hash; otherwise it is reported (``CorruptFileWarning``, ``storage.read_cached``), deleted
+and computed again.
 """
 
 import dataclasses
 import pathlib
-import warnings
 
 import numpy as np
 
@@ -43,32 +45,37 @@ class Chunk:
 
 @dataclasses.dataclass(frozen=True)
 class Layout:
-  """What every chunk of one collection must fit."""
+  """What every chunk of one collection must fit, and which collection it belongs to."""
 
   episodes: int
   steps: int  # Control steps of the longest episode.
   num_modules: int
   state_size: int
+  collection: str = ""  # The dataset's key (``dataset.dataset_key``): robot, samples, seed, ...
 
 
 def chunk_path(folder: pathlib.Path, start: int, stop: int) -> pathlib.Path:
   return folder / f"chunk-{start:06d}-{stop:06d}.npz"
 
 
-def write(folder: pathlib.Path, chunk: Chunk) -> None:
-  arrays = chunk.arrays()
+def write(folder: pathlib.Path, chunk: Chunk, collection: str) -> None:
+  """Saves ``chunk`` of the collection keyed ``collection`` (``Layout.collection``)."""
+  arrays = {**chunk.arrays(), "collection": np.array(collection)}
   arrays["sha256"] = np.array(storage.arrays_sha256(arrays))
-  storage.write_atomically(chunk_path(folder, chunk.start, chunk.stop), storage.npz_bytes(arrays))
+  storage.write_cache_file(chunk_path(folder, chunk.start, chunk.stop), storage.npz_bytes(arrays),
+                           "babbling chunk")
 
 
 def read(path: pathlib.Path, layout: Layout) -> Chunk:
   """The chunk in ``path``; raises ChunkError (one line) if it fails a check."""
   arrays = dataset.read_npz(path.read_bytes(), ChunkError)
-  if sorted(arrays) != ["final_states", "poses", "sha256", "steps"]:
+  if sorted(arrays) != ["collection", "final_states", "poses", "sha256", "steps"]:
     raise ChunkError(f"holds arrays {sorted(arrays)}")
   stored_hash = arrays.pop("sha256")
   if stored_hash.shape != () or str(stored_hash) != storage.arrays_sha256(arrays):
     raise ChunkError("sha256 mismatch (corrupt file)")
+  if str(arrays.pop("collection")) != layout.collection:
+    raise ChunkError(f"a chunk of another collection, not of {layout.collection}")
   start, stop = (int(step) for step in arrays["steps"])
   if (f"-{start:06d}-{stop:06d}." not in path.name or not 0 <= start < stop <= layout.steps
       or arrays["poses"].shape != (layout.episodes, stop - start, layout.num_modules,
@@ -80,7 +87,7 @@ def read(path: pathlib.Path, layout: Layout) -> Chunk:
 
 def resume(folder: pathlib.Path, layout: Layout) -> list[Chunk]:
   """The chain of valid chunks from step 0, as far as it goes; bad chunks on the way are
-  reported with a ``CorruptFileWarning`` and deleted."""
+  reported with a ``CorruptFileWarning`` and deleted (``storage.read_cached``)."""
   chain = []
   step = 0
   while step < layout.steps:
@@ -88,13 +95,10 @@ def resume(folder: pathlib.Path, layout: Layout) -> list[Chunk]:
                         reverse=True)  # The longest first.
     chunk = None
     for path in candidates:
-      try:
-        chunk = read(path, layout)
+      chunk = storage.read_cached(path, lambda found: read(found, layout), "babbling chunk",
+                                  "computing it again")
+      if chunk is not None:
         break
-      except ChunkError as error:
-        warnings.warn(f"{path}: {error}; computing it again", dataset.CorruptFileWarning,
-                      stacklevel=2)
-        path.unlink(missing_ok=True)
     if chunk is None:
       break
     chain.append(chunk)

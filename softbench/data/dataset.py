@@ -39,7 +39,7 @@ import mujoco
 import numpy as np
 
 import softbench
-from smpl.checkpoint import first_line  # An exception's message on one line; used package-wide.
+from smpl.files import first_line  # An exception's message on one line; used package-wide.
 from softbench import robots
 from softbench import storage
 from softbench.data import seeding
@@ -64,8 +64,7 @@ class DatasetError(ValueError):
   """A dataset file is missing, unreadable, corrupt, or not the one its config asks for."""
 
 
-class CorruptFileWarning(UserWarning):
-  """A saved chunk, dataset or checkpoint failed its checks and is computed again."""
+CorruptFileWarning = storage.CorruptFileWarning  # Where cache readers report damage.
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -202,7 +201,7 @@ def write(folder: pathlib.Path, config: dict, arrays: dict[str, np.ndarray],
           collection: dict) -> None:
   """Writes ``dataset.npz`` then ``dataset.json`` atomically (layout in the module docstring)."""
   content = storage.npz_bytes(arrays)
-  storage.write_atomically(folder / NPZ_NAME, content)
+  storage.write_cache_file(folder / NPZ_NAME, content, "dataset")
   manifest = {
       "format": FORMAT,
       "key": dataset_key(config),
@@ -214,8 +213,8 @@ def write(folder: pathlib.Path, config: dict, arrays: dict[str, np.ndarray],
                  for name, array in sorted(arrays.items())},
       "collection": {"softbench_version": softbench.__version__, **collection},
   }
-  storage.write_atomically(folder / JSON_NAME, json.dumps(manifest, indent=2, sort_keys=True)
-                           + "\n")
+  storage.write_cache_file(folder / JSON_NAME, json.dumps(manifest, indent=2, sort_keys=True)
+                           + "\n", "dataset's manifest")
 
 
 def read(folder: str | pathlib.Path, expected_config: dict | None = None) -> Dataset:

@@ -17,9 +17,16 @@ HELD_OUT_BABBLING_STREAM = 1  # The suite's held-out babbling trajectory (task `
 RANDOM_AGENT_STREAM = 2  # The `random` agent's actions (softbench.agents.random_actions).
 
 
+MAX_SEED = 2**32 - 1  # The largest seed every consumer takes (numpy's RandomState, MuJoCo).
+
+
 def check_seed(seed: int) -> None:
-  if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
-    raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
+  """The one seed rule of softbench: an integer from 0 to ``MAX_SEED``; a one-line ValueError
+  otherwise (a bool, a float, a string, a negative or too large number)."""
+  if (isinstance(seed, bool) or not isinstance(seed, numbers.Integral)
+      or not 0 <= seed <= MAX_SEED):
+    shown = repr(seed) if len(repr(seed)) <= 40 else f"{repr(seed)[:40]}..."
+    raise ValueError(f"seed must be an integer from 0 to {MAX_SEED}, got {shown}")
 
 
 def rng(seed: int, stream: int, *index: int) -> np.random.Generator:

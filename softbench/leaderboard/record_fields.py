@@ -13,7 +13,7 @@ from softbench import profiles
 
 INTEGRITY_FIELD = "sha256"
 AGENT_PATTERN = r"^[a-z0-9][a-z0-9_.-]*$"
-ROBOT_PATTERN = r"^(tendon-[0-9]+|tendon-local-[0-9]+|pneumatic-433)$"
+ROBOT_PATTERN = r"^(tendon-[1-9][0-9]*|tendon-local-[1-9][0-9]*|pneumatic-433)$"
 MAX_ERROR = 1e6
 """Bound on every error in a record (mm, deg, %, pose MSE). The arms are at most 0.5 m long, so
 real errors stay below a few thousand; the bound refuses absurd values (1e308 would overflow the

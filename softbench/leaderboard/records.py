@@ -137,7 +137,7 @@ def seal(record: dict) -> dict:
   """
   sealed = copy.deepcopy({name: value for name, value in record.items()
                           if name != INTEGRITY_FIELD})
-  _check_finite(sealed, "record")
+  check_finite(sealed, "record")
   sealed[INTEGRITY_FIELD] = content_sha256(sealed)
   validate(sealed, "record")
   return sealed
@@ -231,7 +231,7 @@ def validate(record: object, source: str) -> None:
            if isinstance(version, int) and version < kind.version else
            f"this softbench reads version {kind.version}")
     raise RecordError(f"{source}: record version {_shortened(repr(version))} is not read: {why}")
-  _check_finite(record, source)
+  check_finite(record, source)
   error = schema_exceptions.best_match(
       jsonschema.Draft202012Validator(kind.schema()).iter_errors(record))
   if error is not None:
@@ -273,15 +273,17 @@ def _describe(error: schema_exceptions.ValidationError) -> str:
   return f"{where}: {_shortened(error.message)}"
 
 
-def _check_finite(value: object, source: str, path: tuple = ()) -> None:
+def check_finite(value: object, source: str, path: tuple = ()) -> None:
+  """Raises a one-line RecordError naming ``source`` and the place of the first non-finite
+  number in ``value`` (nested dicts and lists)."""
   if isinstance(value, float) and not math.isfinite(value):
     raise RecordError(f"{source}: {_where(path)}: {value} is not a finite number")
   if isinstance(value, dict):
     for key, item in value.items():
-      _check_finite(item, source, path + (key,))
+      check_finite(item, source, path + (key,))
   elif isinstance(value, list):
     for index, item in enumerate(value):
-      _check_finite(item, source, path + (index,))
+      check_finite(item, source, path + (index,))
 
 
 def _check_consistency(record: dict, refuse: record_fields.Refuse) -> None:

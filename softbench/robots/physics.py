@@ -48,9 +48,13 @@ class SoftArmPhysics(mujoco.Physics):
     """Sets the controls of every actuator from an action in [-1, 1]^action_dim.
 
     Raises:
-      ValueError: wrong shape, or an action entry that is NaN, infinite or outside [-1, 1].
+      ValueError: not real numbers (bool, complex, text), wrong shape, or an action entry that
+        is NaN, infinite or outside [-1, 1].
     """
-    action = np.asarray(action, dtype=float)
+    given = np.asarray(action)
+    if given.dtype.kind not in "iuf":  # Casting would drop an imaginary part or read True as 1.
+      raise ValueError(f"action must hold real numbers, got an array of {given.dtype}")
+    action = given.astype(float)
     if action.shape != (self.action_dim,):
       raise ValueError(f"action must have shape ({self.action_dim},), got {action.shape}")
     if not np.all(np.isfinite(action)):

@@ -119,10 +119,13 @@ class CableDrivenArm(base.SoftArm):
   @classmethod
   def from_name(cls, name: str, **overrides) -> "CableDrivenArm":
     """``TendonArm.from_name('tendon-3')``; raises ValueError for a malformed name."""
-    match = re.fullmatch(rf"{re.escape(cls.FAMILY)}-(\d+)", name)
+    # Canonical names only: ASCII digits, no leading zero, no surrounding space.
+    match = re.fullmatch(rf"{re.escape(cls.FAMILY)}-(0|[1-9][0-9]{{0,3}})", name, re.ASCII)
     if not match:
-      raise ValueError(f"malformed {cls.FAMILY} arm name {name!r}; expected {cls.FAMILY}-N with N "
-                       f"from 1 to {MAX_MODULES}")
+      raise ValueError(f"malformed {cls.FAMILY} arm name {name[:40]!r}; expected "
+                       f"{cls.FAMILY}-N with N from 1 to {MAX_MODULES}")
+    if "num_modules" in overrides:
+      raise ValueError(f"{name!r} names its number of modules; drop num_modules")
     return cls(num_modules=int(match.group(1)), **overrides)
 
   @property

@@ -15,9 +15,11 @@ import collections
 import inspect
 from typing import Callable
 
+import numpy as np
 from dm_control.rl import control
 
 from softbench import robots
+from softbench.data import seeding
 from softbench.robots import physics as arm_physics
 from softbench.suite import base
 from softbench.suite import reach
@@ -88,7 +90,8 @@ def load(robot: str | robots.SoftArm, task: str, seed=None, environment_kwargs: 
       (reach), ``trajectory`` (custom), ``initial_actuation`` (all).
 
   Raises:
-    ValueError: unknown robot or task, or an invalid task option (one line).
+    ValueError: unknown robot or task, an invalid task option, or a seed that is not an integer
+      from 0 to ``seeding.MAX_SEED`` (one line).
   """
   entry = describe(task)
   arm = robots.make(robot) if isinstance(robot, str) else robot
@@ -99,6 +102,8 @@ def load(robot: str | robots.SoftArm, task: str, seed=None, environment_kwargs: 
   if unknown:
     raise ValueError(f"task {task!r} has no option {unknown[0]!r}; its options: "
                      f"{', '.join(sorted(options))}")
+  if seed is not None and not isinstance(seed, np.random.RandomState):
+    seeding.check_seed(seed)
   # Targets come from the robot as designed: an actuator fault changes the physics, not the task.
   built = entry.build(arm.without_faults(), random=seed, **task_kwargs)
   physics = arm_physics.SoftArmPhysics.from_robot(arm)

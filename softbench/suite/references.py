@@ -22,8 +22,6 @@ import functools
 import hashlib
 import json
 import os
-import warnings
-import zipfile
 
 import numpy as np
 
@@ -131,25 +129,25 @@ def _config(robot: base.SoftArm, shape: str, length: int) -> dict:
 
 def _load_cached(path, config: dict) -> Reference | None:
   """The cached reference at ``path`` if it is intact and made with ``config``; None if absent,
-  or with a ``CorruptFileWarning`` if damaged (it is then generated again)."""
+  or, damaged, with a ``CorruptFileWarning`` (``storage.read_cached``; it is generated again)."""
   meta_path = path.with_suffix(".json")
-  if not path.exists() or not meta_path.exists():
+  if not meta_path.exists():
     return None
-  try:
-    meta = json.loads(meta_path.read_text())
+
+  def read(npz_path) -> Reference:
+    try:
+      meta = json.loads(meta_path.read_text())
+    except Exception as error:  # Named, since the warning names the arrays' file.
+      raise ValueError(f"{meta_path}: {dataset.first_line(error)}") from None
     if not isinstance(meta, dict):
-      raise ValueError(f"{meta_path.name} is not a JSON object")
-    with np.load(path) as stored:
-      arrays = {"actions": stored["actions"], "poses": stored["poses"]}
+      raise ValueError(f"{meta_path} is not a JSON object")
+    stored = dataset.read_npz(npz_path.read_bytes(), ValueError)
+    arrays = {"actions": stored["actions"], "poses": stored["poses"]}
     if meta.get("config") != config or meta.get("sha256") != storage.arrays_sha256(arrays):
       raise ValueError("content does not match its hash")
-  except (OSError, ValueError, TypeError, KeyError, EOFError, RecursionError,
-          zipfile.BadZipFile) as error:
-    warnings.warn(f"{path}: unreadable cached reference ({dataset.first_line(error)}); "
-                  f"generating it again",
-                  dataset.CorruptFileWarning, stacklevel=3)
-    return None
-  return Reference(config["shape"], arrays["actions"], arrays["poses"])
+    return Reference(config["shape"], arrays["actions"], arrays["poses"])
+
+  return storage.read_cached(path, read, "cached reference", "generating it again", (meta_path,))
 
 
 def reference(robot: base.SoftArm, shape: str, length: int = REFERENCE_LENGTH) -> Reference:
@@ -167,7 +165,8 @@ def reference(robot: base.SoftArm, shape: str, length: int = REFERENCE_LENGTH) -
   actions = pattern_actions(robot, shape, length)
   poses, _ = recorder.PoseRecorder(robot).record(actions[None])
   arrays = {"actions": actions, "poses": poses[0]}
-  storage.write_atomically(path, storage.npz_bytes(arrays))
-  storage.write_atomically(path.with_suffix(".json"), json.dumps(
-      {"config": config, "sha256": storage.arrays_sha256(arrays)}, indent=2) + "\n")
+  storage.write_cache_file(path, storage.npz_bytes(arrays), "cached reference")
+  storage.write_cache_file(path.with_suffix(".json"), json.dumps(
+      {"config": config, "sha256": storage.arrays_sha256(arrays)}, indent=2) + "\n",
+                           "cached reference's description")
   return Reference(shape, actions, poses[0])

@@ -14,6 +14,8 @@ import numpy as np
 from softbench.robots import base
 
 UNIT_TOLERANCE = 1e-3  # Largest accepted | |orientation vector| - 1 |.
+REACH_FACTOR = 2.0  # A target position lies within this many arm lengths of the base; farther
+# is no place the arm can mean (1e300 once ran every episode, then failed writing the record).
 
 
 def _read(path: pathlib.Path) -> np.ndarray:
@@ -38,7 +40,8 @@ def load_trajectory(source, robot: base.SoftArm) -> np.ndarray:
 
   Raises:
     ValueError: unreadable file, wrong shape (the message names the expected one), non-finite
-      values or orientation vectors that are not unit length.
+      values, a position farther than ``REACH_FACTOR`` arm lengths from the base, or
+      orientation vectors that are not unit length.
   """
   modules = robot.num_modules
   expected = (f"(steps, {6 * modules}): per row, each of the {modules} module(s)' tip position "
@@ -60,8 +63,17 @@ def load_trajectory(source, robot: base.SoftArm) -> np.ndarray:
     raise ValueError(f"trajectory for {robot.name} has no rows; expected shape {expected}")
   if not np.all(np.isfinite(targets)):
     raise ValueError("trajectory contains NaN or infinite values")
+  if np.any(np.abs(targets[..., 3:]) > 1.0 + UNIT_TOLERANCE):  # Before squaring: 1e300 overflows.
+    row = int(np.argwhere(np.abs(targets[..., 3:]) > 1.0 + UNIT_TOLERANCE)[0, 0])
+    raise ValueError(f"trajectory row {row}: orientation vectors must have unit length")
   norms = np.linalg.norm(targets[..., 3:], axis=-1)
   if np.any(np.abs(norms - 1.0) > UNIT_TOLERANCE):
     row = int(np.argwhere(np.abs(norms - 1.0) > UNIT_TOLERANCE)[0, 0])
     raise ValueError(f"trajectory row {row}: orientation vectors must have unit length")
+  limit = REACH_FACTOR * robot.length
+  far = np.abs(targets[..., :3]).max(axis=(1, 2)) > limit
+  if np.any(far):
+    raise ValueError(f"trajectory row {int(np.argmax(far))}: a target position lies more than "
+                     f"{limit * 1000:.0f} mm ({REACH_FACTOR:g} arm lengths) from the base of "
+                     f"{robot.name}; positions are in m")
   return targets

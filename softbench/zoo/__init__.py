@@ -30,7 +30,7 @@ import warnings
 
 import torch
 
-from smpl.checkpoint import first_line
+from smpl.files import first_line
 from softbench import storage
 
 VARIABLE = "SOFTBENCH_ZOO"

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import torch
 
-from smpl.checkpoint import CheckpointError, load_cached, load_checkpoint, save_checkpoint
+from smpl.checkpoint import CheckpointError, load_checkpoint, save_checkpoint
 from smpl.progressive import ProgressiveLSTM
 
 
@@ -120,16 +120,13 @@ def test_bytes_that_are_no_checkpoint_give_a_one_line_error(tmp_path: Path, cont
     _assert_one_line_naming(raised.value, path)
 
 
-def test_a_folder_at_the_path_gives_a_one_line_error_and_stays(tmp_path: Path) -> None:
+def test_a_folder_at_the_path_gives_a_one_line_error(tmp_path: Path) -> None:
     path = tmp_path / "smpl.pt"
     (path / "inside").mkdir(parents=True)
     with pytest.raises(CheckpointError) as raised:
         load_checkpoint(path, _network(), _network().config)
     _assert_one_line_naming(raised.value, path)
-    with pytest.raises(CheckpointError, match="a folder") as raised:
-        load_cached(path, _network(), _network().config)
-    _assert_one_line_naming(raised.value, path)
-    assert (path / "inside").is_dir()  # Not ours to delete.
+    assert (path / "inside").is_dir()  # Reading alone changes nothing (caches: smpl.files).
 
 
 def test_a_flipped_byte_in_the_weights_fails_the_hash(tmp_path: Path) -> None:
@@ -207,16 +204,3 @@ def test_damaged_checkpoints_are_refused_or_load_unchanged(tmp_path: Path) -> No
         for name, values in NORMALISATION.items():
             np.testing.assert_array_equal(normalisation[name], values)
     assert refused > len(damaged) // 2
-
-
-def test_load_cached_warns_in_one_line_and_gives_none_for_a_damaged_file(tmp_path: Path) -> None:
-    path, network = _saved(tmp_path)
-    assert load_cached(tmp_path / "absent.pt", _network(), network.config) is None
-    restored = ProgressiveLSTM.from_config(network.config)
-    assert load_cached(path, restored, network.config).keys() == NORMALISATION.keys()
-    path.write_bytes(b"hello")
-    with pytest.warns(UserWarning) as caught:
-        assert load_cached(path, _network(), network.config, UserWarning) is None
-    (warning,) = caught
-    message = str(warning.message)
-    assert str(path) in message and "training it again" in message and "\n" not in message

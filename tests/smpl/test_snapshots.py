@@ -3,7 +3,7 @@
 import pytest
 import torch
 
-from smpl import snapshots, training
+from smpl import files, snapshots, training
 from smpl.baselines import VAELSTMInverse
 from smpl.forward_model import ForwardModel
 from smpl.windows import BabblingWindows, inverse_input_size
@@ -137,7 +137,7 @@ def test_unusable_snapshot_is_ignored_with_a_warning(spoil, tmp_path):
   fresh = forward_model()
   expected = train_forward(fresh, config=config)
   resumed = forward_model()
-  with pytest.warns(RuntimeWarning, match="training that model from the start"), \
+  with pytest.warns(files.CorruptFileWarning, match="training that model from the start"), \
        snapshots.resumable(tmp_path):
     result = train_forward(resumed, config=config)
   assert same_weights(fresh, resumed)
@@ -153,7 +153,7 @@ def test_an_unreadable_snapshot_is_reported_in_one_line(content, tmp_path):
     torch.save({"format": "softbench-smpl-fit-snapshot", "state": Interrupted()}, snapshot)
   else:
     snapshot.write_bytes(b"hello")
-  with pytest.warns(RuntimeWarning) as caught:
+  with pytest.warns(files.CorruptFileWarning) as caught:
     assert snapshots.load(snapshot, "fingerprint") is None
   (warning,) = caught
   message = str(warning.message)
