@@ -281,8 +281,8 @@ def _bad_trajectories(folder: pathlib.Path) -> dict[str, tuple[str, str]]:
   pose = np.array([0.0, 0.0, -0.05, 0.0, 0.0, -1.0])
   np.savetxt(folder / "far.csv", np.tile(np.concatenate([pose, pose * [1, 1, 1e302, 1, 1, 1]]),
                                          (3, 1)), delimiter=",")
-  np.savetxt(folder / "long-axis.csv", np.tile(np.concatenate([pose, pose * [1, 1, 1, 1, 1, 1e300]]),
-                                               (3, 1)),
+  long_axis = np.concatenate([pose, pose * [1, 1, 1, 1, 1, 1e300]])
+  np.savetxt(folder / "long-axis.csv", np.tile(long_axis, (3, 1)),
              delimiter=",")
   return {"missing": ("nowhere.csv", "does not exist"),
           "far": ("far.csv", "arm lengths) from the base of tendon-2"),

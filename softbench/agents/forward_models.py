@@ -6,9 +6,10 @@ through it. So the agents that read the same view with the same seed and profile
 baselines' whole-arm model) and every trial of a tuning study share one: trained as
 ``softbench.protocols.prepare_column`` trains it, cached under ``$SOFTBENCH_HOME/forward`` by a
 hash of everything its weights depend on (``ForwardModelConfig``), or taken from the zoo
-(``softbench.zoo``), and loaded with the weights a fresh training gives, to the bit. An interrupted training resumes from its snapshots
-(``smpl.snapshots``, in the cache file's ``.partial`` folder); a damaged cache file is reported
-and trained again.
+(``softbench.zoo``), and loaded with the weights a fresh training gives, to the bit. An
+interrupted training resumes from its snapshots (``smpl.snapshots``, in the cache file's
+``.partial`` folder); a damaged cache file is reported and trained again
+(``storage.read_cached``).
 """
 
 import contextlib

@@ -8,8 +8,8 @@ range (``steps``), the key of the collection it belongs to (``collection``: a ch
 another collection is refused) and the sha256 of all four (``sha256``, by
 ``storage.arrays_sha256``). Files
 are written atomically. A chunk is used only if it reads back whole, fits the collection and
-matches its hash; otherwise it is reported (``CorruptFileWarning``, ``storage.read_cached``), deleted
-and computed again.
+matches its hash; otherwise it is reported (``CorruptFileWarning``, ``storage.read_cached``),
+deleted and computed again.
 """
 
 import dataclasses
