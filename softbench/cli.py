@@ -369,11 +369,14 @@ def _zoo_add(args: argparse.Namespace) -> None:
   folder = _zoo_folder(args, create=True)
   linked = zoo_catalogue.records_of(chosen, pathlib.Path(args.results))
   files = zoo_catalogue.cache_files(chosen)
-  added = zoo.add([(path, kind) for _, path, kind in files],
-                  {path: linked[seed] for seed, path, kind in files if kind == "agent"}, folder)
+  added, skipped = zoo.add([(path, kind) for _, path, kind in files],
+                           {path: linked[seed] for seed, path, kind in files if kind == "agent"},
+                           folder)
   for entry in added:
     print(f"added {entry.path} ({entry.kind}, {entry.bytes / 1024:.1f} KiB, "
           f"{len(entry.records)} records)")
+  for path in skipped:
+    print(f"skipped {path.name}: its training has not started in the data home")
   print(f"zoo: {zoo.size_bytes(zoo.read_manifest(folder)) / 2**20:.1f} MiB of "
         f"{zoo.BUDGET_BYTES / 2**20:.0f} MiB ({folder})")
 

@@ -135,9 +135,10 @@ def test_an_unfinished_training_goes_on_from_the_zoo_in_another_home(
     actions(agent_name)
   chosen = catalogue.setting(agent_name, ROBOT, None, "tiny", 1)
   files = [(path, kind) for _, path, kind in catalogue.cache_files(chosen)]
-  added = zoo.add([entry for entry in files if entry[0].is_file()
-                   or entry[0].with_suffix(zoo.PARTIAL_SUFFIX).is_dir()], {}, tmp_path / "zoo")
+  added, skipped = zoo.add(files, {}, tmp_path / "zoo")
   assert "training-state" in {entry.kind for entry in added}
+  assert skipped == [path for path, _ in files  # Not started when the training stopped.
+                     if not path.exists() and not path.with_suffix(zoo.PARTIAL_SUFFIX).exists()]
   capsys.readouterr()
   use(monkeypatch, tmp_path / "second", tmp_path / "zoo")  # Another machine's empty home.
   np.testing.assert_array_equal(actions(agent_name), uninterrupted)
@@ -229,7 +230,7 @@ def test_verify_reports_a_record_the_zoo_does_not_reproduce(tmp_path, monkeypatc
     (["--protocol", "exp2s"], "unknown protocol"),
     (["--family", "tendon-local"], "--family goes with --protocol"),
     (["--agent", "lstm", "--robot", ROBOT, "--seeds", "0"], "at least 1"),
-    (["--agent", "lstm", "--robot", ROBOT], "neither trained nor being trained"),
+    (["--agent", "lstm", "--robot", ROBOT], "nothing of this setting is trained"),
 ])
 def test_zoo_add_refuses_bad_input_in_one_line(argv, message, tmp_path, monkeypatch, capsys):
   use(monkeypatch, tmp_path / "home")

@@ -195,19 +195,22 @@ def stored_config(path: pathlib.Path) -> dict:
 
 
 def add(cache_files: list[tuple[pathlib.Path, str]], records_of: dict[pathlib.Path, list[str]],
-        zoo: pathlib.Path, budget_bytes: int | None = BUDGET_BYTES) -> list[Entry]:
+        zoo: pathlib.Path, budget_bytes: int | None = BUDGET_BYTES
+        ) -> tuple[list[Entry], list[pathlib.Path]]:
   """Copies each ``(cache file, kind)`` from the data home into ``zoo``, or, for one not yet
-  written, the saved state of its unfinished training (``KEY.partial/``); a finished file
-  replaces the training state the zoo held for it. ``records_of`` names the records each file
-  stands behind. Returns the new or changed entries.
+  written, the saved state of its unfinished training (``KEY.partial/``, which replaces the
+  state the zoo held for it); a finished file replaces the training state the zoo held for it.
+  ``records_of`` names the records each file stands behind. Returns the new or changed entries,
+  and the cache files skipped because their training has not started in the data home.
 
   Raises:
-    ValueError: a file is neither in the data home nor under way there, or the zoo would
-      outgrow ``budget_bytes`` (one line; nothing is changed).
+    ValueError: no file is trained or under way in the data home, or the zoo would outgrow
+      ``budget_bytes`` (one line; nothing is changed).
   """
   home = storage.softbench_home()
   entries = read_manifest(zoo)
   planned: dict[str, tuple[pathlib.Path, Entry]] = {}
+  skipped = []
   for cache_file, kind in cache_files:
     relative = cache_file.relative_to(home).as_posix()
     partial = cache_file.with_suffix(PARTIAL_SUFFIX)
@@ -217,17 +220,21 @@ def add(cache_files: list[tuple[pathlib.Path, str]], records_of: dict[pathlib.Pa
       sources = [(path, "training-state", {}) for path in sorted(partial.iterdir())
                  if path.is_file()]
     else:
-      raise ValueError(f"{cache_file} is neither trained nor being trained in the data home "
-                       f"{home}; run its training first")
+      skipped.append(cache_file)
+      continue
+    # The zoo's training state of this file is replaced: by the finished file, or by the state
+    # the data home holds now.
+    prefix = pathlib.PurePosixPath(relative).with_suffix(PARTIAL_SUFFIX).as_posix() + "/"
+    entries = {path: entry for path, entry in entries.items() if not path.startswith(prefix)}
     for source, source_kind, config in sources:
       path = source.relative_to(home).as_posix()
       records = tuple(sorted(set(records_of.get(cache_file, ())) | set(
           entries[path].records if path in entries else ())))
       planned[path] = (source, Entry(path, file_sha256(source), source.stat().st_size,
                                      source_kind, cache_file.stem, config, records))
-    if cache_file.is_file():  # Its training state is no longer needed.
-      prefix = pathlib.PurePosixPath(relative).with_suffix(PARTIAL_SUFFIX).as_posix() + "/"
-      entries = {path: entry for path, entry in entries.items() if not path.startswith(prefix)}
+  if not planned:
+    raise ValueError(f"nothing of this setting is trained or being trained in the data home "
+                     f"{home}; run its training first")
   updated = {**entries, **{path: entry for path, (_, entry) in planned.items()}}
   total = sum(entry.bytes for entry in updated.values())
   if budget_bytes is not None and total > budget_bytes:
@@ -239,7 +246,7 @@ def add(cache_files: list[tuple[pathlib.Path, str]], records_of: dict[pathlib.Pa
     (zoo / stale).unlink(missing_ok=True)
     _remove_empty_parents(zoo / stale, zoo)
   write_manifest(zoo, updated)
-  return [entry for _, entry in planned.values()]
+  return [entry for _, entry in planned.values()], skipped
 
 
 def _remove_empty_parents(path: pathlib.Path, root: pathlib.Path) -> None:
