@@ -25,7 +25,7 @@ import numpy as np
 import torch
 from torch import nn
 
-from smpl.files import first_line, write_atomically  # noqa: F401  (first_line: used widely)
+from smpl.files import first_line, write_atomically
 
 _FORMAT = "softbench-smpl-checkpoint"
 """Marks a file as one of ours."""

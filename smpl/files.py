@@ -100,6 +100,20 @@ def read_cached(
         return None
 
 
+def write_cache_file(path: Path, content: str | bytes, what: str) -> None:
+    """`write_atomically` for a cache file: anything but a file standing at `path` (a folder) is
+    damage, as for `read_cached`: reported, removed, and the file written in its place."""
+    path = Path(path)
+    if os.path.lexists(path) and not path.is_file():
+        warnings.warn(
+            f"{path}: not a file where the {what} belongs; removing it",
+            CorruptFileWarning,
+            stacklevel=2,
+        )
+        discard(path)
+    write_atomically(path, content)
+
+
 def discard(path: Path) -> None:
     """Removes a damaged cache file, or a folder or link standing where one belongs."""
     if path.is_dir() and not path.is_symlink():

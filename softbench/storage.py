@@ -10,25 +10,14 @@ import io
 import os
 import pathlib
 import tempfile
-import warnings
 
 import numpy as np
 
 from smpl import files
-from smpl.files import CorruptFileWarning, discard, first_line, read_cached  # noqa: F401
+from smpl.files import CorruptFileWarning, first_line, read_cached  # noqa: F401
+from smpl.files import write_cache_file  # noqa: F401  (softbench's caches write through it)
 
 HOME_VARIABLE = "SOFTBENCH_HOME"
-
-
-def write_cache_file(path: pathlib.Path, content: str | bytes, what: str) -> None:
-  """``write_atomically`` for a cache file: anything but a file standing at ``path`` (a folder)
-  is damage, as for ``read_cached``: reported, removed, and the file written in its place."""
-  path = pathlib.Path(path)
-  if os.path.lexists(path) and not path.is_file():
-    warnings.warn(f"{path}: not a file where the {what} belongs; removing it", CorruptFileWarning,
-                  stacklevel=2)
-    discard(path)
-  write_atomically(path, content)
 
 
 def softbench_home() -> pathlib.Path:

@@ -130,12 +130,12 @@ def restore(cache_file: pathlib.Path) -> list[str]:
   A file whose bytes differ from the manifest's sha256 is refused with a ``ZooWarning`` (one
   line), as is an unreadable manifest; the model is then trained as if the zoo had nothing."""
   zoo = folder()
+  if zoo is None or cache_file.exists():  # The common case, first: nothing to take.
+    return []
   home = storage.softbench_home()
   try:
     relative = cache_file.resolve().relative_to(home.resolve()).as_posix()
   except ValueError:  # Not a cache file of the data home.
-    return []
-  if zoo is None or cache_file.exists():
     return []
   try:
     entries = read_manifest(zoo)
@@ -208,8 +208,9 @@ def add(cache_files: list[tuple[pathlib.Path, str]], records_of: dict[pathlib.Pa
       ``budget_bytes`` (one line; nothing is changed).
   """
   home = storage.softbench_home()
-  entries = read_manifest(zoo)
-  planned: dict[str, tuple[pathlib.Path, Entry]] = {}
+  before = read_manifest(zoo)
+  entries = dict(before)
+  planned: dict[str, tuple[bytes, Entry]] = {}
   skipped = []
   for cache_file, kind in cache_files:
     relative = cache_file.relative_to(home).as_posix()
@@ -230,19 +231,20 @@ def add(cache_files: list[tuple[pathlib.Path, str]], records_of: dict[pathlib.Pa
       path = source.relative_to(home).as_posix()
       records = tuple(sorted(set(records_of.get(cache_file, ())) | set(
           entries[path].records if path in entries else ())))
-      planned[path] = (source, Entry(path, file_sha256(source), source.stat().st_size,
-                                     source_kind, cache_file.stem, config, records))
+      content = source.read_bytes()  # Read once: hashed now, written below.
+      planned[path] = (content, Entry(path, hashlib.sha256(content).hexdigest(), len(content),
+                                      source_kind, cache_file.stem, config, records))
   if not planned:
     raise ValueError(f"nothing of this setting is trained or being trained in the data home "
                      f"{home}; run its training first")
   updated = {**entries, **{path: entry for path, (_, entry) in planned.items()}}
-  total = sum(entry.bytes for entry in updated.values())
+  total = size_bytes(updated)
   if budget_bytes is not None and total > budget_bytes:
     raise ValueError(f"the zoo would hold {total / 2**20:.1f} MiB, over its budget of "
                      f"{budget_bytes / 2**20:.0f} MiB; nothing was added")
-  for path, (source, _) in planned.items():
-    storage.write_atomically(zoo / path, source.read_bytes())
-  for stale in set(read_manifest(zoo)) - set(updated):
+  for path, (content, _) in planned.items():
+    storage.write_atomically(zoo / path, content)
+  for stale in set(before) - set(updated):
     (zoo / stale).unlink(missing_ok=True)
     _remove_empty_parents(zoo / stale, zoo)
   write_manifest(zoo, updated)
