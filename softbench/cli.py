@@ -2,12 +2,14 @@
 one line on stderr and exit code 2, a malformed command line included."""
 
 import argparse
+import json
 import os
 import pathlib
 import sys
 
 from dm_control.rl import control
 
+import softbench
 from softbench import adaptive
 from softbench import agents
 from softbench import continual
@@ -35,6 +37,7 @@ from softbench.zoo import catalogue as zoo_catalogue
 from softbench.zoo import verification as zoo_verification
 
 EXIT_USAGE = 2
+_JSON_HELP = "print JSON (for scripts) instead of a table"
 EXIT_FAILURE = 1  # The run itself failed (not the input).
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it.
 
@@ -48,14 +51,33 @@ def _describe(robot: robots.SoftArm) -> str:
           f"{robot.length * 1000:>9.0f} {robot.mass() * 1000:>8.1f}")
 
 
+def _robot_facts(robot: robots.SoftArm) -> dict:
+  """What ``softbench robots --json`` tells of ``robot`` (SI units)."""
+  return {"name": robot.name, "modules": robot.num_modules, "action_dim": robot.action_dim,
+          "actuators_per_module": list(robot.actuators_per_module), "length_m": robot.length,
+          "mass_kg": robot.mass(), "control_period_s": robot.control_timestep}
+
+
+def _print_json(document) -> None:
+  print(json.dumps(document, indent=2, allow_nan=False))
+
+
 def _robots(args: argparse.Namespace) -> None:
   header = f"{'robot':<15} {'modules':>7} {'action dim':>10} {'length mm':>9} {'mass g':>8}"
   if args.name is None:
+    listed = [robots.make(name, **_robot_overrides(args)) for name in robots.BENCHMARK_ROBOTS]
+    if args.json:
+      _print_json([_robot_facts(robot) for robot in listed])
+      return
     print(header)
-    for name in robots.BENCHMARK_ROBOTS:
-      print(_describe(robots.make(name, **_robot_overrides(args))))
+    for robot in listed:
+      print(_describe(robot))
     return
   robot = robots.make(args.name, **_robot_overrides(args))
+  if args.json:
+    _print_json({**_robot_facts(robot),
+                 "spec": {field: value for field, value in model_export.spec_fields(robot)}})
+    return
   print(header)
   print(_describe(robot))
   print(f"\ncontrol period: {robot.control_timestep} s; actions per module: "
@@ -73,6 +95,12 @@ def _models_export(args: argparse.Namespace) -> None:
 
 
 def _tasks(args: argparse.Namespace) -> None:
+  if args.json:
+    _print_json([{"name": task, "tags": list(suite.describe(task).tags),
+                  "description": suite.describe(task).description,
+                  "benchmark_robots": [robot for robot, name in suite.ALL_TASKS if name == task]}
+                 for task in suite.TASKS])
+    return
   print(f"{'task':<10} {'tags':<24} description")
   for task in suite.TASKS:
     entry = suite.describe(task)
@@ -94,6 +122,14 @@ def _collect(args: argparse.Namespace) -> None:
 
 
 def _agents(args: argparse.Namespace) -> None:
+  if args.json:
+    tuned = hyperparameters.load()["agents"]
+    _print_json([{"name": name, "learned": agents.describe(name).learned,
+                  "description": agents.describe(name).description,
+                  "hyperparameters": {robot: values["params"]
+                                      for robot, values in tuned.get(name, {}).items()}}
+                 for name in agents.AGENTS])
+    return
   print(f"{'agent':<10} {'learns':<7} description")
   for name in agents.AGENTS:
     entry = agents.describe(name)
@@ -423,12 +459,15 @@ class _OneLineErrorParser(argparse.ArgumentParser):
 
 def build_parser() -> argparse.ArgumentParser:
   parser = _OneLineErrorParser(prog="softbench", description=__doc__.split(".")[0] + ".")
+  parser.add_argument("--version", action="version", version=f"softbench {softbench.__version__}")
   commands = parser.add_subparsers(dest="command", required=True)
   robots_parser = commands.add_parser("robots", help="list the benchmark robots or describe one")
   robots_parser.add_argument("name", nargs="?", help="e.g. tendon-3 or pneumatic-433")
   robots_parser.add_argument("--module-length", type=float, help="module length in m")
+  robots_parser.add_argument("--json", action="store_true", help=_JSON_HELP)
   robots_parser.set_defaults(run=_robots)
   tasks_parser = commands.add_parser("tasks", help="list the tasks of the suite")
+  tasks_parser.add_argument("--json", action="store_true", help=_JSON_HELP)
   tasks_parser.set_defaults(run=_tasks)
   collect_parser = commands.add_parser(
       "collect", help="record (or resume) a motor-babbling dataset",
@@ -445,6 +484,8 @@ def build_parser() -> argparse.ArgumentParser:
   agents_parser = commands.add_parser("agents", help="list the agents")
   agents_parser.add_argument("--verbose", action="store_true",
                              help="also show each learned agent's hyperparameters")
+  agents_parser.add_argument("--json", action="store_true",
+                             help=_JSON_HELP + ", hyperparameters included")
   agents_parser.set_defaults(run=_agents)
   tune_parser = commands.add_parser(
       "tune", help="tune a learned agent's hyperparameters with Optuna",

@@ -31,6 +31,7 @@ def checkout(tmp_path) -> pathlib.Path:
     pytest.fail("make is not installed; the README's commands need it")
   shutil.copy(MAKEFILE, tmp_path / "Makefile")
   (tmp_path / "pyproject.toml").touch()
+  (tmp_path / "constraints.txt").touch()
   venv_bin = tmp_path / ".venv" / "bin"
   venv_bin.mkdir(parents=True)
   softbench = venv_bin / "softbench"

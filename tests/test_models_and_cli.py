@@ -11,12 +11,14 @@ import numpy as np
 import pytest
 
 import softbench
+from softbench import agents
 from softbench import cli
 from softbench import data
 from softbench import robots
 from softbench import run
 from softbench import storage
 from softbench import suite
+from softbench.agents import hyperparameters
 from softbench.robots import export
 from softbench.robots.physics import SoftArmPhysics
 
@@ -75,6 +77,31 @@ def test_cli_lists_every_benchmark_robot(capsys):
   rows = capsys.readouterr().out.splitlines()[1:]
   assert [row.split()[0] for row in rows] == list(robots.BENCHMARK_ROBOTS)
   assert rows[0].split()[1:3] == ["1", "2"]  # tendon-1: one module, two action entries.
+
+
+def test_cli_lists_robots_tasks_and_agents_as_json(capsys):
+  assert cli.main(["robots", "--json"]) == 0
+  listed = json.loads(capsys.readouterr().out)
+  assert [robot["name"] for robot in listed] == list(robots.BENCHMARK_ROBOTS)
+  for facts in listed:
+    arm = robots.make(facts["name"])
+    assert facts["action_dim"] == arm.action_dim == sum(facts["actuators_per_module"])
+    assert (facts["modules"], facts["length_m"]) == (arm.num_modules, arm.length)
+  assert cli.main(["robots", "tendon-7", "--json"]) == 0
+  described = json.loads(capsys.readouterr().out)
+  assert described["modules"] == 7 and described["spec"]["backbone"] == "cable"
+  assert cli.main(["tasks", "--json"]) == 0
+  tasks = json.loads(capsys.readouterr().out)
+  assert [task["name"] for task in tasks] == list(suite.TASKS)
+  pairs = {(robot, task["name"]) for task in tasks for robot in task["benchmark_robots"]}
+  assert pairs == set(suite.ALL_TASKS)
+  assert cli.main(["agents", "--json"]) == 0
+  listed_agents = json.loads(capsys.readouterr().out)
+  assert [agent["name"] for agent in listed_agents] == list(agents.AGENTS)
+  for agent in listed_agents:
+    assert agent["learned"] == agents.describe(agent["name"]).learned
+    assert bool(agent["hyperparameters"]) == (agent["learned"] and agent["name"] in
+                                              hyperparameters.load()["agents"])
 
 
 def test_cli_describes_any_valid_tendon_arm(capsys):

@@ -32,9 +32,17 @@ from softbench.data.splits import FRACTIONS
 from softbench.data.splits import SPLITS
 from softbench.data.splits import Piece
 from softbench.data.splits import split_pieces
-from softbench.data.views import SplitWindows
-from softbench.data.views import View
-from softbench.data.views import windows
+
+_VIEWS = ("SplitWindows", "View", "windows")  # In data.views, which needs torch: loaded on use,
+# so that the physics side (robots, suite, rendering) imports without torch.
+
+
+def __getattr__(name: str):
+  if name in _VIEWS:
+    from softbench.data import views  # pylint: disable=import-outside-toplevel
+    return getattr(views, name)
+  raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = ["BABBLING_STREAM", "CHUNK_LENGTH", "DEFAULT_SAMPLES", "EPISODE_LENGTH", "FRACTIONS",
            "HELD_OUT_BABBLING_STREAM", "SPLITS", "CorruptFileWarning", "Dataset", "DatasetError",

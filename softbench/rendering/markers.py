@@ -7,6 +7,7 @@ markers and about ``MAX_PATH_SEGMENTS`` path segments per module (the path throu
 step, the same steps in every frame, so that it does not shimmer as it grows).
 """
 
+import functools
 from collections.abc import Sequence
 
 import mujoco
@@ -66,6 +67,28 @@ def _subsample(count: int, limit: int) -> np.ndarray:
   return np.unique(np.linspace(0, count - 1, min(count, limit)).round().astype(int))
 
 
+def target_rgba(colour: np.ndarray) -> np.ndarray:
+  """The colour of a module's current-target marker, from the module's ``colour``."""
+  return _tint(colour, _WHITE, 0.25, 0.85)
+
+
+def target_radius(robot_length: float, arm_radius: float) -> float:
+  """Radius (m) of a current-target marker on an arm of ``robot_length`` and ``arm_radius``."""
+  return max(TARGET_RADIUS * robot_length, TARGET_ARM_SHARE * arm_radius)
+
+
+def add_geom(scene: mujoco.MjvScene, kind: int, size, position, rgba) -> mujoco.MjvGeom | None:
+  """Adds a decoration geom to ``scene``; None (nothing added) when the scene is full."""
+  if scene.ngeom >= scene.maxgeom:
+    return None
+  scene.ngeom += 1  # The scene exposes its first ngeom geoms only.
+  geom = scene.geoms[scene.ngeom - 1]
+  mujoco.mjv_initGeom(geom, kind, np.asarray(size, float), np.asarray(position, float),
+                      np.eye(3).ravel(), rgba)
+  geom.category = mujoco.mjtCatBit.mjCAT_DECOR
+  return geom
+
+
 class EpisodeMarkers:
   """The decorations of one episode; ``at(time, tips)`` moves them to a moment, then the object
   is a dm_control ``scene_callback`` that adds them to the scene."""
@@ -76,7 +99,7 @@ class EpisodeMarkers:
     (m) scale the markers; ``title``: the caption's first line."""
     self._episode = episode
     self._length = robot_length
-    self._target_radius = max(TARGET_RADIUS * robot_length, TARGET_ARM_SHARE * arm_radius)
+    self._target_radius = target_radius(robot_length, arm_radius)
     self._title = title
     scored = np.array(episode.scored_modules) - 1
     self._colours = np.asarray(colours)[scored]
@@ -119,27 +142,16 @@ class EpisodeMarkers:
 
   def __call__(self, physics, scene: mujoco.MjvScene) -> None:
     del physics  # The markers come from the episode; the arm is already in the scene.
-    identity = np.eye(3).ravel()
     step = self._step()
     current = self._episode.targets[step, :, :3]
-
-    def add(kind, size, position, rgba):
-      if scene.ngeom >= scene.maxgeom:
-        return None
-      scene.ngeom += 1  # The scene exposes its first ngeom geoms only.
-      geom = scene.geoms[scene.ngeom - 1]
-      mujoco.mjv_initGeom(geom, kind, np.asarray(size, float), np.asarray(position, float),
-                          identity, rgba)
-      geom.category = mujoco.mjtCatBit.mjCAT_DECOR
-      return geom
-
+    add = functools.partial(add_geom, scene)
     sphere = mujoco.mjtGeom.mjGEOM_SPHERE
     for module, colour in enumerate(self._colours):
       trail_rgba = _tint(colour, _WHITE, 0.45, TRAIL_ALPHA)
       for point in self._trails[module]:
         add(sphere, (TRAIL_RADIUS * self._length,) * 3, point, trail_rgba)
       add(sphere, (self._target_radius,) * 3, current[module],
-          _tint(colour, _WHITE, 0.25, 0.85))
+          target_rgba(colour))
       path = self._path(module)
       path_rgba = _tint(colour, np.zeros(4), 0.35, 1.0)
       for start, end in zip(path[:-1], path[1:]):

@@ -52,6 +52,16 @@ class SoftArmTask(suite_base.Task):
     """Control steps per episode."""
     raise NotImplementedError
 
+  def reseed(self, seed: int) -> None:
+    """Draws the following episodes' random starts (and reach points) from ``seed``, as a task
+    built with ``random=seed`` does."""
+    self._random = np.random.RandomState(seed)
+
+  @property
+  def steps_done(self) -> int:
+    """Control steps taken in this episode; ``targets_at(steps_done)`` is the current target."""
+    return self._step
+
   def scored_modules(self) -> tuple[int, ...]:
     """1-based modules whose poses ``targets_at`` lists, in order."""
     raise NotImplementedError

@@ -1,0 +1,154 @@
+"""A softbench task as a ``gymnasium.Env``: the same physics, targets, reward and seeds as
+``suite.load``, through Gymnasium's API.
+
+Observations are one flat ``Box`` (default) or a ``Dict`` of the task's named arrays:
+
+  poses            (num_modules, 6)  every module's tip: position (m), orientation vector
+  target           (scored, 3 or 6)  what to reach by the end of this step (reach: position)
+  previous_action  (action_dim,)     the action held during the last step, in [-1, 1]
+
+Positions lie within ``trajectories.REACH_FACTOR`` arm lengths of the base (the world origin),
+orientation components within [-1, 1] (plus ``trajectories.UNIT_TOLERANCE`` for targets). The
+flat form concatenates them in that order, each row-major; ``observation_layout`` gives
+the slice of each. Actions are ``Box(-1, 1)``. The episode ends with ``truncated`` when the
+task's reference (or reach's time) runs out; no state of the arm ends it (``terminated`` is
+always False). ``reset(seed=s)`` starts the episode that ``suite.load(..., seed=s)`` starts.
+"""
+
+from typing import Any
+
+import gymnasium
+import numpy as np
+from gymnasium import spaces
+
+from softbench import robots
+from softbench import suite
+from softbench.data import seeding
+from softbench.suite import trajectories
+
+OBSERVATION_FORMS = ("flat", "dict")
+RENDER_MODES = ("rgb_array",)
+_KEYS = ("poses", "target", "previous_action")
+
+
+def _pose_box(spec, robot: robots.SoftArm) -> spaces.Box:
+  """The Box of poses or targets (rows of position, then orientation vector if given): positions
+  within ``REACH_FACTOR`` arm lengths of the base, as the suite accepts targets, and orientation
+  components within a unit vector's (and its tolerance)."""
+  reach = trajectories.REACH_FACTOR * robot.length
+  unit = 1.0 + trajectories.UNIT_TOLERANCE
+  row = np.array([reach] * 3 + [unit] * 3)[:spec.shape[-1]]
+  high = np.broadcast_to(row, spec.shape).astype(spec.dtype)
+  return spaces.Box(-high, high, spec.shape, spec.dtype)
+
+
+class SoftArmEnv(gymnasium.Env):
+  """``task`` on ``robot`` (a name, e.g. ``tendon-3``, or a ``robots.SoftArm``).
+
+  Args:
+    robot: robot name or spec; faults (``robot.with_faults``) change the physics as in the suite.
+    task: one of ``suite.TASKS``.
+    observation: ``"flat"`` (a Box) or ``"dict"``.
+    render_mode: None or ``"rgb_array"`` (headless, the videos' scene and camera).
+    width, height: frame size of ``render`` (pixels).
+    camera: one of ``rendering.options.CAMERAS``.
+    **task_options: the task's options, as ``suite.load`` takes them (``length``, ``module``,
+      ``steps``, ``trajectory``, ``initial_actuation``).
+
+  Raises:
+    ValueError: an unknown robot, task, option or observation form, or a bad option value
+      (one line).
+  """
+
+  metadata = {"render_modes": list(RENDER_MODES), "render_fps": None}
+
+  def __init__(self, robot: str | robots.SoftArm, task: str, observation: str = "flat",
+               render_mode: str | None = None, width: int | None = None,
+               height: int | None = None, camera: str | None = None, **task_options):
+    if observation not in OBSERVATION_FORMS:
+      raise ValueError(f"observation must be one of {', '.join(OBSERVATION_FORMS)}, "
+                       f"got {observation!r}")
+    if render_mode is not None and render_mode not in RENDER_MODES:
+      raise ValueError(f"render_mode must be None or one of {', '.join(RENDER_MODES)}, "
+                       f"got {render_mode!r}")
+    self.robot = robots.make(robot) if isinstance(robot, str) else robot
+    self.task_name = task
+    self._task_options = task_options
+    self._environment = suite.load(self.robot, task, **task_options)
+    self._observation_form = observation
+    self.render_mode = render_mode
+    self.metadata = {**self.metadata, "render_fps": 1.0 / self.robot.control_timestep}
+    named = self._environment.observation_spec()
+    action = named["previous_action"]
+    self._named_spaces = {
+        "poses": _pose_box(named["poses"], self.robot),
+        "target": _pose_box(named["target"], self.robot),
+        "previous_action": spaces.Box(float(action.minimum), float(action.maximum), action.shape,
+                                      action.dtype)}
+    self.observation_layout = {}
+    start = 0
+    for key in _KEYS:
+      size = int(np.prod(named[key].shape))
+      self.observation_layout[key] = slice(start, start + size)
+      start += size
+    if observation == "dict":
+      self.observation_space = spaces.Dict(self._named_spaces)
+    else:
+      self.observation_space = spaces.Box(
+          np.concatenate([space.low.ravel() for space in self._named_spaces.values()]),
+          np.concatenate([space.high.ravel() for space in self._named_spaces.values()]),
+          dtype=np.float64)
+    action = self._environment.action_spec()
+    self.action_space = spaces.Box(-1.0, 1.0, action.shape, np.float32)
+    self._view = None
+    if render_mode is not None:
+      from softbench.rendering import live  # pylint: disable=import-outside-toplevel
+      self._view = live.LiveView(self.robot, width=width, height=height, camera=camera)
+    elif (width, height, camera) != (None, None, None):
+      raise ValueError("width, height and camera need render_mode='rgb_array'")
+    self._ended = True
+
+  @property
+  def dm_env(self):
+    """The ``dm_control.rl.control.Environment`` underneath (its physics and task)."""
+    return self._environment
+
+  def _observation(self, named: dict) -> np.ndarray | dict:
+    if self._observation_form == "dict":
+      return {key: np.array(named[key], dtype=np.float64) for key in _KEYS}
+    return np.concatenate([np.asarray(named[key], np.float64).ravel() for key in _KEYS])
+
+  def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+    """Starts an episode; ``seed`` gives the start and targets ``suite.load(seed=seed)`` gives."""
+    if options:
+      raise ValueError(f"reset takes no options, got {sorted(options)}; pass task options to "
+                       "gymnasium.make")
+    if seed is not None:
+      seeding.check_seed(seed)
+      self._environment.task.reseed(seed)
+    super().reset(seed=seed)
+    time_step = self._environment.reset()
+    self._ended = False
+    if self._view is not None:
+      self._view.start(self._environment.physics, self._environment.task)
+    return self._observation(time_step.observation), {}
+
+  def step(self, action):
+    if self._ended:
+      raise RuntimeError("the episode has ended (or not started); call reset() first")
+    time_step = self._environment.step(np.asarray(action, dtype=np.float64))
+    self._ended = time_step.last()
+    return self._observation(time_step.observation), float(time_step.reward), False, \
+        self._ended, {}
+
+  def render(self) -> np.ndarray | None:
+    """(height, width, 3) uint8: the arm and the current targets, with render_mode
+    ``"rgb_array"``; None without a render mode."""
+    if self._view is None:
+      return None
+    return self._view.render(self._environment.physics, self._environment.task)
+
+  def close(self) -> None:
+    if self._view is not None:
+      self._view.close()
+      self._view = None

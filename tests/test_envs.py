@@ -1,0 +1,204 @@
+"""Properties of every registered Gymnasium environment (``softbench.envs``), and its errors.
+
+Episodes are shortened as in ``test_suite`` (the properties do not depend on their length).
+"""
+
+import subprocess
+import sys
+import warnings
+
+import gymnasium
+import numpy as np
+import pytest
+from gymnasium.utils import env_checker
+
+import softbench.envs
+from softbench import robots
+from softbench import suite
+from softbench.envs import environment
+from softbench.robots import faults
+from softbench.suite import references
+
+SHORT_OPTIONS = {"babbling": {"length": 3}, "circle": {"length": 3}, "rectangle": {"length": 3},
+                 "spiral": {"length": 3}, "reach": {"steps": 2}}
+BENCHMARK_PAIRS = suite.ALL_TASKS
+
+
+@pytest.fixture(autouse=True)
+def shared_cache(tmp_path_factory, monkeypatch):
+  """One temporary data home for the whole file, so references are simulated once."""
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path_factory.getbasetemp() / "softbench_home"))
+
+
+def make(robot, task, **options):
+  return gymnasium.make(softbench.envs.env_id(robot, task), **{**SHORT_OPTIONS[task], **options})
+
+
+def test_every_pair_of_the_suite_is_registered_under_its_id():
+  ids = set(softbench.envs.ENV_IDS)
+  assert {softbench.envs.env_id(robot, task) for robot, task in suite.ALL_TASKS} <= ids
+  assert len(ids) == len(robots.BENCHMARK_ROBOTS) * len(suite.TASKS)
+  assert all(gymnasium.spec(env_id).entry_point == softbench.envs.ENTRY_POINT for env_id in ids)
+
+
+@pytest.mark.parametrize("robot,task", BENCHMARK_PAIRS)
+def test_gymnasium_checker_passes_without_warnings(robot, task):
+  # No random start: the checker resets a dozen times, and the start's randomness is the
+  # seeding tests' subject below.
+  env = make(robot, task, initial_actuation=0.0)
+  with warnings.catch_warnings():
+    warnings.simplefilter("error")
+    env_checker.check_env(env.unwrapped, skip_render_check=True)
+  env.close()
+
+
+@pytest.mark.parametrize("robot,task", BENCHMARK_PAIRS)
+def test_a_seed_starts_the_episode_the_suite_starts_with_that_seed(robot, task):
+  env = make(robot, task)
+  suite_env = suite.load(robot, task, seed=7, **SHORT_OPTIONS[task])
+  action = np.linspace(-0.6, 0.6, env.action_space.shape[0], dtype=np.float32)
+  observation, _ = env.reset(seed=7)
+  first = suite_env.reset()
+  layout = env.unwrapped.observation_layout
+  for key, part in layout.items():
+    np.testing.assert_array_equal(observation[part], first.observation[key].ravel())
+  observation, reward, terminated, truncated, _ = env.step(action)
+  after = suite_env.step(action.astype(np.float64))
+  np.testing.assert_array_equal(observation[layout["poses"]], after.observation["poses"].ravel())
+  assert reward == after.reward and not terminated and not truncated
+  again, _ = env.reset(seed=7)  # The same seed again, on the same environment.
+  np.testing.assert_array_equal(again, make(robot, task).reset(seed=7)[0])
+  other, _ = env.reset(seed=8)
+  assert not np.array_equal(other[layout["previous_action"]], again[layout["previous_action"]])
+
+
+@pytest.mark.parametrize("robot,task", BENCHMARK_PAIRS)
+def test_two_async_environments_step_in_subprocesses(robot, task):
+  env_id = softbench.envs.env_id(robot, task)
+  vector = gymnasium.make_vec(env_id, num_envs=2, vectorization_mode="async",
+                              **{**SHORT_OPTIONS[task], "initial_actuation": 0.0})
+  try:
+    observations, _ = vector.reset(seed=3)
+    assert observations.shape == (2, *vector.single_observation_space.shape)
+    actions = np.stack([np.full(vector.single_action_space.shape, 0.5, np.float32),
+                        np.full(vector.single_action_space.shape, -0.5, np.float32)])
+    stepped, rewards, terminated, truncated, _ = vector.step(actions)
+    assert stepped.shape == observations.shape and np.all(np.isfinite(stepped))
+    assert np.all((rewards >= 0) & (rewards <= 1)) and not terminated.any()
+    layout = gymnasium.make(env_id, **SHORT_OPTIONS[task]).unwrapped.observation_layout
+    assert not np.array_equal(stepped[0, layout["poses"]], stepped[1, layout["poses"]])
+  finally:
+    vector.close()
+
+
+@pytest.mark.parametrize("task", suite.TASKS[:1] + ("reach",))
+def test_an_episode_ends_truncated_when_its_reference_runs_out(task):
+  env = make("tendon-1", task)
+  env.reset(seed=0)
+  ends = [env.step(env.action_space.sample())[2:4] for _ in range(env.unwrapped.dm_env.task.num_steps)]
+  assert ends[:-1] == [(False, False)] * (len(ends) - 1) and ends[-1] == (False, True)
+  with pytest.raises(RuntimeError, match="call reset"):
+    env.unwrapped.step(env.action_space.sample())
+
+
+def test_the_dict_form_holds_the_flat_form_s_parts():
+  flat = make("pneumatic-433", "reach")
+  named = make("pneumatic-433", "reach", observation="dict")
+  vector, _ = flat.reset(seed=2)
+  parts, _ = named.reset(seed=2)
+  assert named.observation_space.contains(parts)
+  for key, part in flat.unwrapped.observation_layout.items():
+    np.testing.assert_array_equal(vector[part], parts[key].ravel())
+  assert parts["target"].shape == (1, 3)  # Reach asks for one module's position.
+
+
+def test_custom_follows_the_trajectory_given_to_make():
+  arm = robots.make("tendon-2")
+  targets = references.reference(arm, "circle", 3).targets
+  env = gymnasium.make(softbench.envs.env_id("tendon-2", "custom"), trajectory=targets)
+  observation, _ = env.reset(seed=0)
+  np.testing.assert_array_equal(observation[env.unwrapped.observation_layout["target"]],
+                                targets[0].ravel())
+
+
+def test_any_robot_and_fault_through_the_generic_id():
+  env = gymnasium.make(softbench.envs.ANY_ROBOT_ID, robot="tendon-7", task="reach", steps=1)
+  observation, _ = env.reset(seed=0)
+  assert observation.shape == (7 * 6 + 3 + robots.make("tendon-7").action_dim,)
+  healthy = robots.make("tendon-2")
+  punctured = healthy.with_faults([faults.Fault(module=2, actuator=0, gain=0.0)])
+  tips = []
+  for arm in (healthy, punctured):
+    env = gymnasium.make(softbench.envs.ANY_ROBOT_ID, robot=arm, task="reach", steps=1)
+    env.reset(seed=0)
+    observation = env.step(np.ones(arm.action_dim, np.float32))[0]
+    tips.append(observation[env.unwrapped.observation_layout["poses"]][6:9])
+  assert np.linalg.norm(tips[0] - tips[1]) > 1e-3  # (m) The fault changes the physics.
+
+
+@pytest.mark.parametrize("robot", robots.BENCHMARK_ROBOTS)
+def test_rgb_array_frames_show_the_arm_headlessly(robot):
+  env = make(robot, "reach", render_mode="rgb_array", width=96, height=64)
+  env.reset(seed=0)
+  first = env.render()
+  env.step(np.ones(env.action_space.shape, np.float32))
+  moved = env.render()
+  assert first.shape == (64, 96, 3) and first.dtype == np.uint8
+  assert first.std() > 0 and not np.array_equal(first, moved)
+  env.close()
+
+
+@pytest.mark.parametrize("make_env,message", [
+    (lambda: gymnasium.make("softbench/tendon-3-spiral-v0", lenght=3), "no option 'lenght'"),
+    (lambda: gymnasium.make("softbench/tendon-3-custom-v0"), "needs a trajectory"),
+    (lambda: gymnasium.make("softbench/tendon-3-reach-v0", module=4), "module must be 1 to 3"),
+    (lambda: gymnasium.make("softbench/tendon-3-reach-v0", observation="image"),
+     "observation must be one of flat, dict"),
+    (lambda: environment.SoftArmEnv("tendon-3", "reach", render_mode="ansi"),
+     "render_mode must be None or one of rgb_array"),
+    (lambda: gymnasium.make("softbench/tendon-3-reach-v0", width=64), "need render_mode"),
+    (lambda: gymnasium.make("softbench/tendon-3-reach-v0", render_mode="rgb_array", width=7),
+     "width must be an even number"),
+    (lambda: gymnasium.make(softbench.envs.ANY_ROBOT_ID, robot="tendon-03", task="reach"),
+     "tendon-03"),
+    (lambda: gymnasium.make(softbench.envs.ANY_ROBOT_ID, robot="tendon-3", task="wave"),
+     "unknown task 'wave'"),
+])
+def test_bad_options_get_one_line_errors(make_env, message):
+  with pytest.raises(ValueError, match=message) as error:
+    make_env()
+  assert "\n" not in str(error.value)
+
+
+@pytest.mark.parametrize("seed", [-1, 2**32, 1.5])
+def test_bad_seeds_and_reset_options_get_one_line_errors(seed):
+  env = make("tendon-1", "reach")
+  with pytest.raises(ValueError, match="seed") as error:
+    env.reset(seed=seed)
+  assert "\n" not in str(error.value)
+  with pytest.raises(ValueError, match="reset takes no options"):
+    env.reset(options={"length": 2})
+
+
+def test_render_before_reset_and_step_before_reset_are_clear_errors():
+  env = environment.SoftArmEnv("tendon-1", "reach", render_mode="rgb_array", width=32, height=32)
+  with pytest.raises(RuntimeError, match="reset"):
+    env.render()
+  with pytest.raises(RuntimeError, match="reset"):
+    env.step(np.zeros(4, np.float32))
+
+
+def test_the_physics_side_and_the_environments_import_without_torch():
+  code = ("import sys, softbench.suite, softbench.robots, softbench.rendering.video, "
+          "softbench.rendering.live, softbench.envs; print('torch' in sys.modules)")
+  result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          check=True)
+  assert result.stdout.strip() == "False"
+
+
+def test_a_make_without_importing_softbench_uses_the_module_form():
+  code = ("import gymnasium; env = gymnasium.make('softbench.envs:softbench/tendon-1-reach-v0', "
+          "steps=1); print(env.reset(seed=0)[0].shape)")
+  result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          check=True)
+  assert result.stdout.strip() == "(11,)"  # tendon-1: one pose (6), the point (3), 2 cables.
