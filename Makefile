@@ -35,7 +35,7 @@ WORKERS ?=# Processes per run (softbench run --workers); empty: one per core.
 RESULTS := leaderboard/results
 LEADERBOARD_ROBOTS := tendon-3 tendon-local-3 pneumatic-433
 LEADERBOARD_TASKS := babbling circle rectangle spiral reach
-LEADERBOARD_AGENTS := smpl mlp lstm vae-lstm bilstm reference zero random
+LEADERBOARD_AGENTS := smpl mlp lstm vae-lstm bilstm sac reference zero random
 EXP1S_FAMILIES := tendon tendon-local
 leaderboard: $(STAMP)
 	set -e; for robot in $(LEADERBOARD_ROBOTS); do for task in $(LEADERBOARD_TASKS); do \

@@ -135,7 +135,7 @@ def _agents(args: argparse.Namespace) -> None:
     entry = agents.describe(name)
     print(f"{name:<10} {'yes' if entry.learned else 'no':<7} {entry.description}")
     if args.verbose and entry.learned:
-      for robot, values in hyperparameters.load()["agents"][name].items():
+      for robot, values in hyperparameters.load()["agents"].get(name, {}).items():
         study = values["study"]
         origin = "not tuned"
         if study is not None:

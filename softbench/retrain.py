@@ -63,10 +63,8 @@ def settings(agent: str = RETRAINED_AGENT, robot: str | None = None, faults: tup
   if agent != RETRAINED_AGENT:
     raise ValueError(f"retrain adapts the {RETRAINED_AGENT} agent (one column per module), "
                      f"got {agent!r}")
-  entry = agents.describe(baseline)
-  if not entry.learned or baseline == RETRAINED_AGENT:
-    learners = [name for name in agents.AGENTS
-                if agents.describe(name).learned and name != RETRAINED_AGENT]
+  if agents.learner(baseline) is None or baseline == RETRAINED_AGENT:
+    learners = [name for name in agents.babbling_learners() if name != RETRAINED_AGENT]
     raise ValueError(f"baseline must be a centralised learned agent ({', '.join(learners)}), "
                      f"got {baseline!r}")
   if not faults:

@@ -126,8 +126,9 @@ def _check_adaptive(task: str, agent: str, robot: str, seeds: int | None, module
     reach.check_module(robots.make(robot), module)
   if adaptive and task != "reach":
     raise ValueError(f"--adaptive goes with --task reach, not {task!r}: it reaches a point")
-  if adaptive and not agents.describe(agent).learned:
-    raise ValueError(f"--adaptive needs a learned agent, not {agent!r}")
+  if adaptive and agents.learner(agent) is None:
+    raise ValueError(f"--adaptive needs an agent trained on babbling "
+                     f"({', '.join(agents.babbling_learners())}), not {agent!r}")
   if adaptive and seeds not in (None, 1):
     raise ValueError("--adaptive uses one trained agent (seed 0); vary --targets, not --seeds")
   if (targets is not None or helpers is not None) and not adaptive:
@@ -381,6 +382,9 @@ def execute_episodes(run: RunSettings, show_progress: bool = True, workers: int 
     if not trained:
       data.collect(run.robot, samples=run.profile.samples, seed=learned.DATA_SEED,
                    progress=show_progress)
+  elif agents.describe(run.agent).learned:  # It learns by acting, on the babbling targets (sac).
+    data.collect(run.robot, samples=run.profile.samples, seed=learned.DATA_SEED,
+                 progress=show_progress)
   if run.adaptive:
     section = adaptive_activation.run(run.robot, run.agent, run.profile, run.targets,
                                       run.module, run.eval_mode, run.helpers, show_progress)
@@ -395,6 +399,11 @@ def execute_episodes(run: RunSettings, show_progress: bool = True, workers: int 
       episode_snapshots.discard(run)
     results = {"scored_modules": list(outcomes[0][1].scored_modules),
                "per_seed": [entry for entry, _ in outcomes]}
+    spent = [agents.training_summary(run.agent, arm, seed, run.profile)
+             for seed in range(run.seeds)]
+    if any(summary is not None for summary in spent):  # An agent that learns by acting.
+      results["training"] = {"per_seed": [{"seed": seed, **(summary or {})}
+                                          for seed, summary in enumerate(spent)]}
   record = {
       "format": RECORD_FORMAT, "version": RECORD_VERSION, **origin,
       "robot": run.robot, "task": run.task, "agent": run.agent, "profile": run.profile.name,

@@ -109,8 +109,7 @@ def reach_actions(agent, active=None, helpers="hold", seed=0):
     agent.active_modules, agent.helper_targets = None, "hold"
 
 
-@pytest.mark.parametrize("agent_name", [name for name in agents.AGENTS
-                                        if agents.describe(name).learned])
+@pytest.mark.parametrize("agent_name", agents.babbling_learners())
 class TestMasking:
 
   def test_inactive_modules_get_exactly_zero(self, agent_name):
@@ -198,7 +197,7 @@ def test_softbench_run_adaptive_end_to_end(tmp_path, capsys):
     (["--task", "reach", "--agent", "smpl", "--adaptive", "--targets", "0"],
      "targets must be a positive integer"),
     (["--task", "reach", "--agent", "smpl", "--targets", "3"], "go with --adaptive"),
-    (["--task", "reach", "--agent", "zero", "--adaptive"], "needs a learned agent"),
+    (["--task", "reach", "--agent", "zero", "--adaptive"], "needs an agent trained on babbling"),
     (["--task", "reach", "--agent", "smpl", "--adaptive", "--seeds", "3"], "vary --targets"),
     (["--task", "reach", "--agent", "smpl", "--adaptive", "--helpers", "push"],
      "unknown helpers"),

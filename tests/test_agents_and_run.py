@@ -136,7 +136,7 @@ def test_a_folder_at_a_checkpoint_path_is_damage_reported_and_replaced(tmp_path,
   assert path.is_file()
 
 
-@pytest.mark.parametrize("agent_name", LEARNED_AGENTS)
+@pytest.mark.parametrize("agent_name", agents.babbling_learners())  # sac: in test_sac.
 def test_interrupted_training_resumes_to_the_same_checkpoint(agent_name, interrupted_training,
                                                              tmp_path, monkeypatch):
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))

@@ -40,8 +40,9 @@ def run(robot: str, agent: str, profile: profiles.Profile, targets: int = DEFAUL
   arm = robots.make(robot)
   module = reach.check_module(arm, module)
   experiment.check_helpers(helpers)
-  if not agents.describe(agent).learned:
-    raise ValueError(f"--adaptive needs a learned agent, got {agent!r}")
+  if agents.learner(agent) is None:
+    raise ValueError(f"--adaptive needs an agent trained on babbling "
+                     f"({', '.join(agents.babbling_learners())}), got {agent!r}")
   learner = experiment.check_agent(
       agents.make(agent, arm, experiment.AGENT_SEED, profile, show_progress))
   learner.error_source = eval_mode

@@ -23,6 +23,8 @@ _AGENTS = {
     "lstm": AgentEntry("softbench.agents.lstm", True, "LSTM baseline"),
     "vae-lstm": AgentEntry("softbench.agents.vae_lstm", True, "variational LSTM baseline"),
     "bilstm": AgentEntry("softbench.agents.bilstm", True, "bidirectional LSTM baseline"),
+    "sac": AgentEntry("softbench.agents.sac", True,
+                      "SAC (Stable-Baselines3): model-free RL, learns by acting on the arm"),
     "zero": AgentEntry("softbench.agents.zero", False, "always the zero action (sanity check)"),
     "random": AgentEntry("softbench.agents.random_actions", False,
                          "uniform random actions (sanity check)"),
@@ -56,9 +58,25 @@ def make(name: str, robot: str | robots.SoftArm, seed: int = 0,
 
 
 def learner(name: str):
-  """The ``softbench.agents.learned.Learner`` of a learned agent, None for the others."""
+  """The ``softbench.agents.learned.Learner`` of an agent trained on babbling (an inverse model
+  in closed loop, ``smpl.training``), None for the others (sac learns by interaction)."""
   entry = describe(name)
   return importlib.import_module(entry.module).LEARNER if entry.learned else None
 
 
-__all__ = ["AGENTS", "Agent", "EpisodeInfo", "describe", "learner", "make"]
+def training_summary(name: str, robot: robots.SoftArm, seed: int,
+                     profile: profiles.Profile) -> dict | None:
+  """What an agent that learns by acting spent on ``seed``'s training (environment steps,
+  episodes, wall time), read from its cache; None for the other agents."""
+  summary = getattr(importlib.import_module(describe(name).module), "training_summary", None)
+  return None if summary is None else summary(robot, seed, profile)
+
+
+def babbling_learners() -> tuple[str, ...]:
+  """The agents with a ``learner``: those that tuning, retraining and adaptive activation
+  take."""
+  return tuple(name for name in AGENTS if learner(name) is not None)
+
+
+__all__ = ["AGENTS", "Agent", "EpisodeInfo", "babbling_learners", "describe", "learner", "make",
+           "training_summary"]

@@ -15,6 +15,8 @@ import numpy as np
 BABBLING_STREAM = 0  # Training motor babbling (softbench.data.collect); index: episode.
 HELD_OUT_BABBLING_STREAM = 1  # The suite's held-out babbling trajectory (task `babbling`).
 RANDOM_AGENT_STREAM = 2  # The `random` agent's actions (softbench.agents.random_actions).
+TARGET_STREAM_EPISODES = 3  # Which stretch of targets an interaction episode follows, and its
+# random start (softbench.envs.streams); index: episode.
 
 
 MAX_SEED = 2**32 - 1  # The largest seed every consumer takes (numpy's RandomState, MuJoCo).

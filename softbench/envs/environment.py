@@ -28,7 +28,22 @@ from softbench.suite import trajectories
 
 OBSERVATION_FORMS = ("flat", "dict")
 RENDER_MODES = ("rgb_array",)
-_KEYS = ("poses", "target", "previous_action")
+KEYS = ("poses", "target", "previous_action")  # The observation's parts, in the flat order.
+
+
+def flatten(named: dict) -> np.ndarray:
+  """The flat form (float64) of an observation of named parts (``KEYS``)."""
+  return np.concatenate([np.asarray(named[key], np.float64).ravel() for key in KEYS])
+
+
+def layout(shapes: dict[str, tuple[int, ...]]) -> dict[str, slice]:
+  """Where each part of ``shapes`` (by name, ``KEYS``) lies in the flat form."""
+  slices, start = {}, 0
+  for key in KEYS:
+    size = int(np.prod(shapes[key]))
+    slices[key] = slice(start, start + size)
+    start += size
+  return slices
 
 
 def _pose_box(spec, robot: robots.SoftArm) -> spaces.Box:
@@ -85,12 +100,8 @@ class SoftArmEnv(gymnasium.Env):
         "target": _pose_box(named["target"], self.robot),
         "previous_action": spaces.Box(float(action.minimum), float(action.maximum), action.shape,
                                       action.dtype)}
-    self.observation_layout = {}
-    start = 0
-    for key in _KEYS:
-      size = int(np.prod(named[key].shape))
-      self.observation_layout[key] = slice(start, start + size)
-      start += size
+    self.observation_shapes = {key: tuple(named[key].shape) for key in KEYS}
+    self.observation_layout = layout(self.observation_shapes)
     if observation == "dict":
       self.observation_space = spaces.Dict(self._named_spaces)
     else:
@@ -115,8 +126,8 @@ class SoftArmEnv(gymnasium.Env):
 
   def _observation(self, named: dict) -> np.ndarray | dict:
     if self._observation_form == "dict":
-      return {key: np.array(named[key], dtype=np.float64) for key in _KEYS}
-    return np.concatenate([np.asarray(named[key], np.float64).ravel() for key in _KEYS])
+      return {key: np.array(named[key], dtype=np.float64) for key in KEYS}
+    return flatten(named)
 
   def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
     """Starts an episode; ``seed`` gives the start and targets ``suite.load(seed=seed)`` gives."""

@@ -103,10 +103,9 @@ def settings(agent: str, robot: str, trials: int = DEFAULT_TRIALS, storage_url: 
       trial, epochs outside 1 .. the profile's, an empty study name or a storage that cannot be
       opened (one line).
   """
-  if not agents.describe(agent).learned:
-    learners = ", ".join(name for name in agents.AGENTS if agents.describe(name).learned)
-    raise ValueError(f"agent {agent!r} does not learn, so it has nothing to tune; choose one of "
-                     f"{learners}")
+  if agents.learner(agent) is None:
+    raise ValueError(f"agent {agent!r} is not trained on babbling, so it has nothing to tune "
+                     f"here; choose one of {', '.join(agents.babbling_learners())}")
   robots.make(robot)
   chosen_profile = profiles.get(profile)
   if isinstance(trials, bool) or not isinstance(trials, int) or trials < 1:

@@ -51,7 +51,8 @@ def setting(agent: str | None, robot: str | None, family: str | None, profile: s
     raise ValueError("name the setting: --agent AGENT --robot ROBOT, or --protocol "
                      f"{continual.PROTOCOL} [--family FAMILY]")
   if agents.learner(agent) is None:
-    raise ValueError(f"{agent!r} does not learn: the zoo keeps trained weights only")
+    raise ValueError(f"the zoo keeps the weights of agents trained on babbling "
+                     f"({', '.join(agents.babbling_learners())}), not of {agent!r}")
   robots.make(robot)
   return Setting(chosen, seeds, agent=agent, robot=robot)
 

@@ -1,0 +1,281 @@
+"""``sac``: Soft Actor-Critic (Stable-Baselines3), a model-free agent that learns by acting on the
+simulated arm through softbench's Gymnasium environment, not from a model of it.
+
+Training: ``STEPS[profile]`` environment steps of episodes that each follow ``EPISODE_STEPS``
+consecutive poses of the babbling dataset's training split (``envs.streams``: random reachable
+targets, the data the supervised agents learn from; the ``babbling`` task scores held-out ones),
+the reward being the task's. It acts on the task's observation (``SoftArmEnv``'s flat form), with
+positions in arm lengths (``policy_input``). The trained model is cached in the data home like
+every checkpoint, with the environment steps and wall time it took; an interrupted training
+resumes from its saved state (model, optimisers, replay buffer, random generators; saved at
+least every ``snapshots.SAVE_INTERVAL_S``) to the same weights as an uninterrupted one.
+"""
+
+import dataclasses
+import hashlib
+import io
+import pathlib
+import random
+import time
+
+import numpy as np
+import stable_baselines3
+import torch
+from stable_baselines3.common import vec_env
+
+from smpl import snapshots
+from smpl import training
+from softbench import data
+from softbench import profiles
+from softbench import storage
+from softbench.agents import base
+from softbench.data import progress as progress_bars
+from softbench.envs import environment
+from softbench.envs import streams
+from softbench.robots import base as robot_base
+
+LEARNER = None  # Not trained on babbling through smpl.training (agents.learner).
+EPISODE_STEPS = 50  # Control steps (targets) per training episode.
+STEPS = {"paper": 300_000, "default": 30_000, "tiny": 200}  # Environment steps per profile.
+LEARNING_STARTS = {"paper": 5_000, "default": 2_000, "tiny": 50}  # Random steps before learning.
+CHUNK_STEPS = 1_000  # Steps per `learn` call; the state may be saved after each (a multiple of
+# EPISODE_STEPS, so that saves fall between episodes).
+HYPERPARAMETERS = {
+    "learning_rate": 3e-4, "batch_size": 256, "tau": 0.005, "train_freq": 1,
+    "gradient_steps": 1,
+    # The pose after a step depends mostly on that step's action (the arms settle within one
+    # control period, tendon-5 in 0.72 s of 1 s), so little reward lies beyond a few steps.
+    "gamma": 0.9,
+    "net_arch": (256, 256),
+}
+TRAINING_VERSION = 1  # Bump when training changes, so that cached models are not reused.
+DATA_SEED = 0  # The babbling dataset every agent learns from (as agents.learned).
+_FORMAT = "softbench-sac"
+
+
+def policy_input(flat: np.ndarray, shapes: dict[str, tuple[int, ...]],
+                 length: float) -> np.ndarray:
+  """The policy's input: a flat observation (``environment.flatten``) of parts of ``shapes``,
+  every position (the first 3 columns of poses and targets) divided by the arm ``length`` (m),
+  as float32."""
+  scaled = np.array(flat, dtype=np.float32)
+  for key, part in environment.layout(shapes).items():
+    if key in ("poses", "target"):
+      rows = scaled[part].reshape(shapes[key])
+      rows[:, :3] /= length
+      scaled[part] = rows.ravel()
+  return scaled
+
+
+@dataclasses.dataclass(frozen=True)
+class TrainingConfig:
+  """Everything a trained model depends on; its hash names the checkpoint."""
+
+  robot: str
+  robot_xml_sha256: str
+  samples: int
+  seed: int
+  steps: int
+  learning_starts: int
+  episode_steps: int
+  hyperparameters: tuple
+  stable_baselines3: str
+  training_version: int = TRAINING_VERSION
+
+  @property
+  def key(self) -> str:
+    text = repr(dataclasses.astuple(self)).encode()
+    return f"sac-{self.robot}-seed{self.seed}-{hashlib.sha256(text).hexdigest()[:12]}"
+
+
+def training_config(robot: robot_base.SoftArm, seed: int,
+                    profile: profiles.Profile) -> TrainingConfig:
+  return TrainingConfig(robot.name, hashlib.sha256(robot.to_xml().encode()).hexdigest(),
+                        profile.samples, seed, STEPS[profile.name], LEARNING_STARTS[profile.name],
+                        EPISODE_STEPS, tuple(sorted(HYPERPARAMETERS.items())),
+                        stable_baselines3.__version__.split(".")[0])
+
+
+def checkpoint_path(robot: robot_base.SoftArm, seed: int, profile: profiles.Profile
+                    ) -> pathlib.Path:
+  """Where the trained model of ``seed`` is cached (it exists once trained)."""
+  key = training_config(robot, seed, profile).key
+  return storage.softbench_home() / "checkpoints" / f"{key}.pt"
+
+
+class _PolicyInput(vec_env.VecEnvWrapper):
+  """The training environments' observations as ``policy_input``."""
+
+  def __init__(self, venv: vec_env.VecEnv, shapes: dict[str, tuple[int, ...]], length: float):
+    low = policy_input(venv.observation_space.low, shapes, length)
+    high = policy_input(venv.observation_space.high, shapes, length)
+    space = type(venv.observation_space)(low, high, dtype=np.float32)
+    super().__init__(venv, observation_space=space)
+    self._shapes, self._length = shapes, length
+
+  def _scaled(self, observations: np.ndarray) -> np.ndarray:
+    return np.stack([policy_input(row, self._shapes, self._length) for row in observations])
+
+  def reset(self):
+    return self._scaled(self.venv.reset())
+
+  def step_wait(self):
+    observations, rewards, dones, infos = self.venv.step_wait()
+    return self._scaled(observations), rewards, dones, infos
+
+
+def _training_env(robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
+                  first_episode: int) -> tuple[_PolicyInput, streams.TargetStreamEnv]:
+  dataset = data.collect(robot.name, samples=profile.samples, seed=DATA_SEED, progress=False)
+  stream_env = streams.TargetStreamEnv(robot, streams.training_targets(dataset, EPISODE_STEPS),
+                                       EPISODE_STEPS, seed, first_episode)
+  venv = vec_env.DummyVecEnv([lambda: stream_env])
+  return _PolicyInput(venv, stream_env.observation_shapes, robot.length), stream_env
+
+
+def _model_kwargs() -> dict:
+  values = dict(HYPERPARAMETERS)
+  return {**{key: value for key, value in values.items() if key != "net_arch"},
+          "policy_kwargs": {"net_arch": list(values["net_arch"])}}
+
+
+def _random_states(model) -> dict:
+  numpy_state = np.random.get_state(legacy=False)
+  return {"torch": torch.get_rng_state(), "numpy": numpy_state, "python": random.getstate(),
+          "action_space": model.action_space.np_random.bit_generator.state}
+
+
+def _restore_random_states(model, states: dict) -> None:
+  torch.set_rng_state(states["torch"])
+  np.random.set_state(states["numpy"])
+  random.setstate(states["python"])
+  model.action_space.np_random.bit_generator.state = states["action_space"]
+
+
+def _read(path: pathlib.Path, config: TrainingConfig, kind: str) -> dict:
+  """The saved dict at ``path``, checked to be of ``kind`` and made for ``config``."""
+  saved = torch.load(path, map_location="cpu", weights_only=False)
+  if (not isinstance(saved, dict) or saved.get("format") != _FORMAT or saved.get("kind") != kind
+      or saved.get("config") != dataclasses.asdict(config)):
+    raise ValueError("not a sac model of this configuration")
+  return saved
+
+
+def _save_state(path: pathlib.Path, config: TrainingConfig, model, stream_env, elapsed: float,
+                last_observation: np.ndarray) -> None:
+  model_bytes, buffer_bytes = io.BytesIO(), io.BytesIO()
+  model.save(model_bytes)
+  model.save_replay_buffer(buffer_bytes)
+  state = {"format": _FORMAT, "kind": "training-state", "config": dataclasses.asdict(config),
+           "model": model_bytes.getvalue(), "replay_buffer": buffer_bytes.getvalue(),
+           "random": _random_states(model),
+           # Saves fall between episodes: the one under way has just begun, and a resumed
+           # training begins it again, at the observation the model holds.
+           "episode_under_way": stream_env.episodes_started - 1,
+           "last_observation": last_observation, "wall_time_s": elapsed}
+  content = io.BytesIO()
+  torch.save(state, content)
+  storage.write_cache_file(path, content.getvalue(), "sac training state")
+
+
+def train(robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
+          show_progress: bool = False) -> dict:
+  """The trained model of ``seed`` (its saved dict): from the cache, or trained now (resuming a
+  saved state) and cached."""
+  config = training_config(robot, seed, profile)
+  path = checkpoint_path(robot, seed, profile)
+  finished = storage.read_cached(path, lambda file: _read(file, config, "model"),
+                                 "cached sac model", "training it again")
+  if finished is not None:
+    return finished
+  partial = path.with_suffix(".partial.pt")
+  state = storage.read_cached(partial, lambda file: _read(file, config, "training-state"),
+                              "sac training state", "training from the start")
+  device = training.default_device()
+  with training.limited_cpu_threads(training.CPU_THREADS, device):
+    venv, stream_env = _training_env(robot, seed, profile,
+                                     state["episode_under_way"] if state else 0)
+    if state is None:
+      model = stable_baselines3.SAC("MlpPolicy", venv, seed=seed, device=device,
+                                    buffer_size=config.steps,
+                                    learning_starts=config.learning_starts, **_model_kwargs())
+      elapsed = 0.0
+    else:
+      model = stable_baselines3.SAC.load(io.BytesIO(state["model"]), env=venv, device=device)
+      model.load_replay_buffer(io.BytesIO(state["replay_buffer"]))
+      _restore_random_states(model, state["random"])
+      model._last_obs = venv.reset()  # pylint: disable=protected-access
+      if not np.array_equal(model._last_obs, state["last_observation"]):  # pylint: disable=protected-access
+        raise RuntimeError(f"{partial}: the resumed episode does not start where the saved "
+                           "training stopped; delete the file to train from the start")
+      elapsed = state["wall_time_s"]
+    started, saved_at = time.perf_counter() - elapsed, time.monotonic()
+    with progress_bars.SampleProgress(f"sac {robot.name} seed {seed}", config.steps,
+                                      model.num_timesteps, show_progress) as bar:
+      while model.num_timesteps < config.steps:
+        chunk = min(CHUNK_STEPS, config.steps - model.num_timesteps)
+        model.learn(chunk, reset_num_timesteps=False)
+        bar.update(model.num_timesteps)
+        if (model.num_timesteps < config.steps
+            and time.monotonic() - saved_at >= snapshots.SAVE_INTERVAL_S):
+          _save_state(partial, config, model, stream_env, time.perf_counter() - started,
+                      model._last_obs)  # pylint: disable=protected-access
+          saved_at = time.monotonic()
+  model_bytes = io.BytesIO()
+  model.save(model_bytes, exclude=["replay_buffer"])
+  finished = {"format": _FORMAT, "kind": "model", "config": dataclasses.asdict(config),
+              "model": model_bytes.getvalue(), "environment_steps": int(model.num_timesteps),
+              "episodes": stream_env.episodes_started,
+              "wall_time_s": round(time.perf_counter() - started, 3)}
+  content = io.BytesIO()
+  torch.save(finished, content)
+  storage.write_cache_file(path, content.getvalue(), "cached sac model")
+  partial.unlink(missing_ok=True)
+  return finished
+
+
+class SACAgent(base.Agent):
+  """Acts with a trained SAC policy, deterministically (the mean action).
+
+  It was trained to reach whole-arm poses: a task that scores some modules, or positions only
+  (reach), has its target completed as the learned agents' ``hold`` rule does: every module's
+  starting pose, the scored modules' given parts replaced by the target.
+  """
+
+  def __init__(self, robot: robot_base.SoftArm, seed: int, trained: dict):
+    super().__init__(robot, seed)
+    self.training = {key: trained[key] for key in ("environment_steps", "episodes",
+                                                   "wall_time_s")}
+    self._model = stable_baselines3.SAC.load(io.BytesIO(trained["model"]), device="cpu")
+
+  def reset(self, episode: base.EpisodeInfo) -> None:
+    self._scored = np.array(episode.scored_modules) - 1
+    self._start = None
+
+  def act(self, observation: dict) -> np.ndarray:
+    if self._start is None:
+      self._start = np.array(observation["poses"], dtype=float)
+    given = np.asarray(observation["target"], dtype=float)
+    target = self._start.copy()
+    target[self._scored, :given.shape[1]] = given
+    whole = {**observation, "target": target}
+    shapes = {key: np.shape(whole[key]) for key in environment.KEYS}
+    action, _ = self._model.predict(
+        policy_input(environment.flatten(whole), shapes, self.robot.length), deterministic=True)
+    return np.asarray(action, dtype=np.float64)
+
+
+def build(robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
+          show_progress: bool = False) -> base.Agent:
+  return SACAgent(robot, seed, train(robot, seed, profile, show_progress))
+
+
+def training_summary(robot: robot_base.SoftArm, seed: int, profile: profiles.Profile
+                     ) -> dict | None:
+  """The environment steps, episodes and wall time of ``seed``'s cached model; None if absent."""
+  config = training_config(robot, seed, profile)
+  saved = storage.read_cached(checkpoint_path(robot, seed, profile),
+                              lambda file: _read(file, config, "model"), "cached sac model",
+                              "training it again")
+  return None if saved is None else {key: saved[key] for key in ("environment_steps", "episodes",
+                                                                   "wall_time_s")}

@@ -1,0 +1,82 @@
+"""Episodes that follow stretches of a stream of reachable poses: what an agent that learns by
+interaction (``softbench.agents.sac``) trains on.
+
+The stream is the robot's babbling dataset, training split (the poses the supervised agents
+learn from; the suite's ``babbling`` task follows held-out ones). Episode i follows
+``episode_steps`` consecutive poses of one piece of that split, drawn, with its random start,
+from the stream ``seeding.TARGET_STREAM_EPISODES`` at index i: the sequence of episodes is fixed
+by the seed, so a training that resumes at episode i sees what it would have seen.
+"""
+
+import gymnasium
+import numpy as np
+
+from softbench import robots
+from softbench.data import dataset as babbling_dataset
+from softbench.data import seeding
+from softbench.data import splits
+from softbench.envs import environment
+
+
+def training_targets(data: babbling_dataset.Dataset, episode_steps: int) -> list[np.ndarray]:
+  """The pieces of ``data``'s training split long enough for an episode, as target poses
+  (samples, num_modules, 6): the pose reached after each action."""
+  pieces = splits.split_pieces(data.episode_lengths)["train"]
+  targets = [piece.recording(data)[0][1:] for piece in pieces]
+  usable = [piece for piece in targets if len(piece) >= episode_steps]
+  if not usable:
+    raise ValueError(f"no training piece of {data.path} holds {episode_steps} steps; collect "
+                     "more samples or shorten the episodes")
+  return usable
+
+
+class TargetStreamEnv(gymnasium.Env):
+  """``SoftArmEnv`` on the ``custom`` task, a new stretch of ``stream`` every episode.
+
+  Args:
+    robot: the robot.
+    stream: pieces of target poses, each (samples, num_modules, 6), at least
+      ``episode_steps`` long.
+    episode_steps: control steps (targets) per episode.
+    seed: seed of the episode sequence.
+    first_episode: the index of the episode that the first ``reset`` starts (a resumed
+      training's next one).
+
+  ``reset``'s ``seed`` is not used: the episodes are the seed's sequence, in order.
+  """
+
+  metadata = {"render_modes": []}
+
+  def __init__(self, robot: robots.SoftArm, stream: list[np.ndarray], episode_steps: int,
+               seed: int, first_episode: int = 0):
+    seeding.check_seed(seed)
+    if not all(len(piece) >= episode_steps for piece in stream) or not stream:
+      raise ValueError(f"every piece of the stream needs at least {episode_steps} targets")
+    self.robot = robot
+    self._stream = stream
+    self._weights = np.array([len(piece) - episode_steps + 1 for piece in stream], float)
+    self._weights /= self._weights.sum()
+    self.episode_steps = episode_steps
+    self._seed = seed
+    self.episodes_started = first_episode
+    self._env = environment.SoftArmEnv(robot, "custom", trajectory=stream[0][:episode_steps])
+    self.observation_space = self._env.observation_space
+    self.action_space = self._env.action_space
+    self.observation_shapes = self._env.observation_shapes
+
+  def window(self, episode: int) -> tuple[np.ndarray, int]:
+    """The targets (episode_steps, num_modules, 6) of ``episode`` and its start's seed."""
+    draw = seeding.rng(self._seed, seeding.TARGET_STREAM_EPISODES, episode)
+    piece = self._stream[draw.choice(len(self._stream), p=self._weights)]
+    start = int(draw.integers(0, len(piece) - self.episode_steps + 1))
+    return piece[start:start + self.episode_steps], int(draw.integers(0, seeding.MAX_SEED))
+
+  def reset(self, *, seed=None, options=None):
+    del seed, options  # The episodes are the seed's sequence (class docstring).
+    targets, start_seed = self.window(self.episodes_started)
+    self.episodes_started += 1
+    self._env = environment.SoftArmEnv(self.robot, "custom", trajectory=targets)
+    return self._env.reset(seed=start_seed)
+
+  def step(self, action):
+    return self._env.step(action)

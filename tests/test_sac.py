@@ -1,0 +1,107 @@
+"""The sac agent: its training stream, its input scaling, and a training that resumes to the same
+weights (the registry-wide agent tests cover its acting and records)."""
+
+import numpy as np
+import pytest
+import stable_baselines3
+import torch
+
+from smpl import snapshots
+from softbench import data
+from softbench import profiles
+from softbench import robots
+from softbench.agents import sac
+from softbench.data import splits
+from softbench.envs import environment
+from softbench.envs import streams
+
+ROBOT = "tendon-1"
+TINY = profiles.get("tiny")
+
+
+@pytest.fixture
+def home(tmp_path, monkeypatch):
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / "home"))
+  monkeypatch.setattr(sac, "CHUNK_STEPS", 50)  # Four chunks in the tiny profile's 200 steps.
+  monkeypatch.setattr(snapshots, "SAVE_INTERVAL_S", 0.0)  # Save after every chunk.
+  return tmp_path / "home"
+
+
+def _weights(trained: dict) -> dict[str, torch.Tensor]:
+  import io  # pylint: disable=import-outside-toplevel
+  return stable_baselines3.SAC.load(io.BytesIO(trained["model"])).policy.state_dict()
+
+
+def test_an_interrupted_training_resumes_to_the_same_weights(home, tmp_path, monkeypatch):
+  arm = robots.make(ROBOT)
+  whole = sac.train(arm, 0, TINY)
+  assert whole["environment_steps"] == sac.STEPS["tiny"]
+  assert whole["episodes"] == sac.STEPS["tiny"] // sac.EPISODE_STEPS + 1  # The next one begun.
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / "other"))
+  learn, calls = stable_baselines3.SAC.learn, []
+
+  def interrupted_in_the_third_chunk(model, *args, **kwargs):
+    calls.append(model.num_timesteps)
+    if len(calls) == 3:
+      raise KeyboardInterrupt
+    return learn(model, *args, **kwargs)
+
+  with monkeypatch.context() as patched:
+    patched.setattr(stable_baselines3.SAC, "learn", interrupted_in_the_third_chunk)
+    with pytest.raises(KeyboardInterrupt):
+      sac.train(arm, 0, TINY)
+  assert calls == [0, 50, 100]
+  partial = sac.checkpoint_path(arm, 0, TINY).with_suffix(".partial.pt")
+  assert partial.is_file() and not sac.checkpoint_path(arm, 0, TINY).exists()
+  resumed = sac.train(arm, 0, TINY)
+  assert not partial.exists()
+  assert resumed["environment_steps"] == whole["environment_steps"]
+  first, second = _weights(whole), _weights(resumed)
+  assert first.keys() == second.keys()
+  for name in first:
+    assert torch.equal(first[name], second[name]), name
+
+
+def test_a_damaged_model_is_reported_and_trained_again(home):
+  arm = robots.make(ROBOT)
+  trained = sac.train(arm, 1, TINY)
+  path = sac.checkpoint_path(arm, 1, TINY)
+  path.write_bytes(path.read_bytes()[:100])
+  with pytest.warns(data.CorruptFileWarning, match="cached sac model"):
+    again = sac.train(arm, 1, TINY)
+  for name, value in _weights(trained).items():
+    assert torch.equal(value, _weights(again)[name])
+
+
+def test_training_episodes_follow_training_stretches_fixed_by_the_seed(home):
+  arm = robots.make(ROBOT)
+  dataset = data.collect(ROBOT, samples=TINY.samples, seed=sac.DATA_SEED, progress=False)
+  stream = streams.training_targets(dataset, 10)
+  env = streams.TargetStreamEnv(arm, stream, 10, seed=4)
+  later = streams.TargetStreamEnv(arm, stream, 10, seed=4, first_episode=2)
+  train_pieces = splits.split_pieces(dataset.episode_lengths)["train"]
+  training_poses = np.concatenate([piece.recording(dataset)[0][1:] for piece in train_pieces])
+  windows = []
+  for episode in range(3):
+    observation, _ = env.reset()
+    targets, _ = env.window(episode)
+    windows.append(targets)
+    np.testing.assert_array_equal(observation[env.observation_space.shape[0] - arm.action_dim
+                                              - targets[0].size:-arm.action_dim],
+                                  targets[0].ravel())
+    assert all(np.any(np.all(training_poses == pose, axis=(1, 2))) for pose in targets)
+  np.testing.assert_array_equal(later.reset()[0], env.__class__(arm, stream, 10, 4, 2).reset()[0])
+  assert not np.array_equal(windows[0], windows[1])
+  rewards = [env.step(env.action_space.sample())[1] for _ in range(10)]
+  assert all(0 <= reward <= 1 for reward in rewards)
+
+
+def test_policy_input_scales_positions_only():
+  shapes = {"poses": (2, 6), "target": (1, 3), "previous_action": (4,)}
+  named = {"poses": np.arange(12.0).reshape(2, 6), "target": np.array([[1.0, 2.0, 3.0]]),
+           "previous_action": np.array([0.5, -0.5, 1.0, 0.0])}
+  scaled = sac.policy_input(environment.flatten(named), shapes, length=2.0)
+  assert scaled.dtype == np.float32
+  np.testing.assert_array_equal(scaled[:12], [0, 0.5, 1, 3, 4, 5, 3, 3.5, 4, 9, 10, 11])
+  np.testing.assert_array_equal(scaled[12:15], [0.5, 1.0, 1.5])
+  np.testing.assert_array_equal(scaled[15:], named["previous_action"])
