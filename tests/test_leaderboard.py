@@ -264,6 +264,23 @@ def test_ranking(results):
   assert board.groups[2].metrics == ("position_mm", "normalised_tip_percent")
 
 
+def test_an_agent_that_learns_by_acting_shows_its_steps_and_ranks_with_the_others(real_record,
+                                                                                  tmp_path):
+  folder = tmp_path / "results"
+  spent = {"per_seed": [{"seed": 0, "environment_steps": 30000, "episodes": 601,
+                         "wall_time_s": 1500.0},
+                        {"seed": 1, "environment_steps": 30000, "episodes": 601,
+                         "wall_time_s": 2100.0}]}
+  run.write_record(variant(real_record, agent="sac", scale=0.5, training=spent),
+                   folder / "sac.json")
+  run.write_record(variant(real_record, zoo={"files": ["checkpoints/x.pt"]}), folder / "zero.json")
+  (circle,) = leaderboard.build(folder).groups  # Neither section makes a group of its own.
+  assert [entry.shown_setting for entry in circle.entries] == [
+      ("sac (30,000 steps, 30 min per seed)", "tiny", "physics"), ("zero", "tiny", "physics")]
+  with pytest.raises(records.RecordError, match="environment_steps"):
+    variant(real_record, agent="sac", training={"per_seed": [{"seed": 0, "environment_steps": 0}]})
+
+
 def test_the_overview_shows_every_plain_task_of_every_agent(results):
   board = leaderboard.build(results)
   (view,) = overview.overviews(board)

@@ -137,7 +137,7 @@ def _table(group: ranking.Group, out: pathlib.Path) -> str:
   body = []
   for place, entry in enumerate(group.entries, start=1):
     cells = [f'<td class="number">{place}</td>',
-             *(f"<td>{_e(value)}</td>" for value in entry.setting),
+             *(f"<td>{_e(value)}</td>" for value in entry.shown_setting),
              f'<td class="number">{entry.record["seeds"]}</td>']
     for name in group.metrics:
       estimate = entry.estimates.get(name)

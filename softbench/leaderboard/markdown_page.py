@@ -58,7 +58,7 @@ def _table(group: ranking.Group, out: pathlib.Path) -> list[str]:
            "|" + "|".join("---:" if name in ("#", "seeds") else "---" for name in header) + "|"]
   for place, entry in enumerate(group.entries, start=1):
     video = links.video(entry, out)
-    cells = ([str(place), *map(_escaped, entry.setting), str(entry.record["seeds"])] +
+    cells = ([str(place), *map(_escaped, entry.shown_setting), str(entry.record["seeds"])] +
              [ranking.cell(entry.estimates.get(name)) for name in group.metrics] +
              [_link("video", video) if video else "-",
               _link(entry.path.name, links.record(entry, out))])

@@ -84,6 +84,20 @@ class Entry:
   def label(self) -> str:
     return " / ".join(self.setting)
 
+  @property
+  def shown_setting(self) -> tuple[str, str, str]:
+    """``setting`` as tables show it: an agent that learned by acting (a ``training`` section)
+    with its environment steps and mean training wall time per seed."""
+    agent, profile, eval_mode = self.setting
+    spent = self.record.get("training", {}).get("per_seed", [])
+    if spent and all("environment_steps" in seed for seed in spent):
+      steps = {seed["environment_steps"] for seed in spent}
+      seconds = float(np.mean([seed["wall_time_s"] for seed in spent]))
+      took = (f"{seconds:.0f} s" if seconds < 60 else f"{seconds / 60:.0f} min"
+              if seconds < 7200 else f"{seconds / 3600:.1f} h")
+      agent += f" ({'/'.join(f'{count:,}' for count in sorted(steps))} steps, {took} per seed)"
+    return agent, profile, eval_mode
+
 
 @dataclasses.dataclass(frozen=True)
 class Group:

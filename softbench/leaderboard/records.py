@@ -41,7 +41,7 @@ INTEGRITY_FIELD = record_fields.INTEGRITY_FIELD
 METRICS = ("position_mm", "orientation_deg", "normalised_tip_percent")
 """Errors a record may hold per seed; position and normalised tip error always, orientation
 except for position-only tasks (reach)."""
-_OPTIONAL_FIELDS = ("video", "faults")
+_OPTIONAL_FIELDS = ("video", "faults", "zoo", "training")
 ADAPTIVE_SECTION = "adaptive"  # softbench run --adaptive: per-target results, no per-seed ones.
 _MEAN_TOLERANCE = 1e-9  # Relative: a seed's mean against the mean of its per-module values.
 _MAX_MESSAGE_CHARS = 160  # Of a schema error's message, so that a refusal stays one line.
@@ -87,6 +87,18 @@ def schema() -> dict:
                          "actuator": {"type": "integer", "minimum": 0},
                          "gain": {"type": "number", "minimum": 0, "maximum": 1},
                          "text": {"type": "string"}}}},
+      # The zoo files a run took instead of training (softbench.zoo.section).
+      "zoo": {"type": "object", "required": ["files"], "properties": {"files": {
+          "type": "array", "items": {"type": "string", "minLength": 1}, "minItems": 1}}},
+      # What an agent that learns by acting spent per seed (softbench.agents.training_summary).
+      "training": {"type": "object", "required": ["per_seed"], "properties": {"per_seed": {
+          "type": "array", "items": {
+              "type": "object", "required": ["seed"],
+              "properties": {"seed": {"type": "integer", "minimum": 0},
+                             "environment_steps": {"type": "integer", "minimum": 1},
+                             "episodes": {"type": "integer", "minimum": 1},
+                             "wall_time_s": record_fields.non_negative(
+                                 record_fields.MAX_WALL_TIME_S)}}}}},
       **record_fields.properties(),
   }
   return {

@@ -43,7 +43,7 @@ def table(group: ranking.Group) -> str:
   header += [ranking.METRIC_LABELS[name] for name in group.metrics]
   rows = [header]
   for place, entry in enumerate(group.entries, start=1):
-    rows.append([str(place), *entry.setting, str(entry.record["seeds"])] +
+    rows.append([str(place), *entry.shown_setting, str(entry.record["seeds"])] +
                 [ranking.cell(entry.estimates.get(name)) for name in group.metrics])
   lines = [group.title, *("  " + line for line in _aligned(rows, right={0, 4}))]
   for entry in group.superseded:
