@@ -22,7 +22,7 @@ TINY = profiles.get("tiny")
 @pytest.fixture
 def home(tmp_path, monkeypatch):
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / "home"))
-  monkeypatch.setattr(sac, "CHUNK_STEPS", 50)  # Four chunks in the tiny profile's 200 steps.
+  monkeypatch.setattr(sac, "CHUNK_STEPS", 50)  # Two chunks in the tiny profile's 100 steps.
   monkeypatch.setattr(snapshots, "SAVE_INTERVAL_S", 0.0)  # Save after every chunk.
   return tmp_path / "home"
 
@@ -40,17 +40,17 @@ def test_an_interrupted_training_resumes_to_the_same_weights(home, tmp_path, mon
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / "other"))
   learn, calls = stable_baselines3.SAC.learn, []
 
-  def interrupted_in_the_third_chunk(model, *args, **kwargs):
+  def interrupted_in_the_second_chunk(model, *args, **kwargs):
     calls.append(model.num_timesteps)
-    if len(calls) == 3:
+    if len(calls) == 2:
       raise KeyboardInterrupt
     return learn(model, *args, **kwargs)
 
   with monkeypatch.context() as patched:
-    patched.setattr(stable_baselines3.SAC, "learn", interrupted_in_the_third_chunk)
+    patched.setattr(stable_baselines3.SAC, "learn", interrupted_in_the_second_chunk)
     with pytest.raises(KeyboardInterrupt):
       sac.train(arm, 0, TINY)
-  assert calls == [0, 50, 100]
+  assert calls == [0, 50]  # Saved after the first chunk, which learned from its last step.
   partial = sac.checkpoint_path(arm, 0, TINY).with_suffix(".partial.pt")
   assert partial.is_file() and not sac.checkpoint_path(arm, 0, TINY).exists()
   resumed = sac.train(arm, 0, TINY)
