@@ -241,7 +241,8 @@ def score_seed(seed: int, profile: profiles.Profile, show_progress: bool,
         path = kept_episodes / f"{name}.json"
         entry = episode_snapshots.load_scores(path, subject)
         if entry is None:
-          env = suite.load(arm, task, seed=seed, **profile.episode_options(task))
+          env = suite.load(arm, task, seed=seed,
+                           **suite.length_options(task, profile.episode_length))
           episode = evaluation.run_episode(env, agent, task, show_progress)
           entry = _end_effector_scores(episode, arm.length)
           episode_snapshots.save_scores(path, entry, subject)

@@ -18,14 +18,8 @@ class Profile:
   patience: int  # Epochs without a better validation loss before training stops.
   seeds: int  # Training and evaluation seeds.
   compile: bool  # torch.compile the training step (smpl.training.TrainingConfig.compile).
-  episode_length: int | None = None  # Tracking targets per episode; None: the task's default.
-
-  def episode_options(self, task: str) -> dict:
-    """The ``suite.load`` option that sets ``task``'s episode length to the profile's, if any
-    (``reach`` counts control steps, the tracking tasks targets)."""
-    if self.episode_length is None:
-      return {}
-    return {"steps" if task == "reach" else "length": self.episode_length}
+  episode_length: int | None = None  # Control steps per episode (suite.length_options); None:
+  # the task's default.
 
 
 PROFILES = {

@@ -49,10 +49,6 @@ from softbench.suite import reach
 from softbench.suite import trajectories
 from softbench.robots import faults as fault_model
 
-PAPER_ROBOT = {"babbling": "tendon-3", "circle": "tendon-3", "rectangle": "tendon-3",
-               "spiral": "tendon-3", "custom": "tendon-3", "reach": "pneumatic-433"}
-"""The robot each task runs on in the paper (Exp2S tasks on tendon-3; reaching on the pneumatic
-arm), the default of ``--robot``."""
 METRICS = (("position_mm", "position (mm)"), ("orientation_deg", "orientation (deg)"),
            ("normalised_tip_percent", "tip error (%)"))
 _POLL_SECONDS = 0.2  # (s) How often the parent looks at its worker processes.
@@ -94,7 +90,7 @@ def settings(task: str, agent: str, robot: str | None = None, seeds: int | None 
   suite.describe(task)
   agents.describe(agent)
   chosen = profiles.get(profile)
-  robot = robot or PAPER_ROBOT[task]
+  robot = robot or suite.describe(task).paper_robot
   parsed_faults = tuple(fault_model.parse(text) for text in faults)
   robots.make(robot).with_faults(parsed_faults)
   _check_adaptive(task, agent, robot, seeds, module, adaptive, targets, helpers)
@@ -144,7 +140,7 @@ def task_options(run: RunSettings) -> dict:
   if run.task == "custom":
     return {"trajectory": run.trajectory}
   options = {} if run.module is None else {"module": run.module}
-  return {**options, **run.profile.episode_options(run.task)}
+  return {**options, **suite.length_options(run.task, run.profile.episode_length)}
 
 
 def _seed_scores(score: metrics.TrackingScore) -> dict:

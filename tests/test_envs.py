@@ -19,8 +19,11 @@ from softbench.envs import environment
 from softbench.robots import faults
 from softbench.suite import references
 
-SHORT_OPTIONS = {"babbling": {"length": 3}, "circle": {"length": 3}, "rectangle": {"length": 3},
-                 "spiral": {"length": 3}, "reach": {"steps": 2}}
+SHORT_STEPS = 3  # Control steps of every shortened episode (as in test_suite: shared references).
+
+
+def short(task: str) -> dict:
+  return suite.length_options(task, SHORT_STEPS)
 BENCHMARK_PAIRS = suite.ALL_TASKS
 
 
@@ -31,7 +34,7 @@ def shared_cache(tmp_path_factory, monkeypatch):
 
 
 def make(robot, task, **options):
-  return gymnasium.make(softbench.envs.env_id(robot, task), **{**SHORT_OPTIONS[task], **options})
+  return gymnasium.make(softbench.envs.env_id(robot, task), **{**short(task), **options})
 
 
 def test_every_pair_of_the_suite_is_registered_under_its_id():
@@ -55,7 +58,7 @@ def test_gymnasium_checker_passes_without_warnings(robot, task):
 @pytest.mark.parametrize("robot,task", BENCHMARK_PAIRS)
 def test_a_seed_starts_the_episode_the_suite_starts_with_that_seed(robot, task):
   env = make(robot, task)
-  suite_env = suite.load(robot, task, seed=7, **SHORT_OPTIONS[task])
+  suite_env = suite.load(robot, task, seed=7, **short(task))
   action = np.linspace(-0.6, 0.6, env.action_space.shape[0], dtype=np.float32)
   observation, _ = env.reset(seed=7)
   first = suite_env.reset()
@@ -76,7 +79,7 @@ def test_a_seed_starts_the_episode_the_suite_starts_with_that_seed(robot, task):
 def test_two_async_environments_step_in_subprocesses(robot, task):
   env_id = softbench.envs.env_id(robot, task)
   vector = gymnasium.make_vec(env_id, num_envs=2, vectorization_mode="async",
-                              **{**SHORT_OPTIONS[task], "initial_actuation": 0.0})
+                              **{**short(task), "initial_actuation": 0.0})
   try:
     observations, _ = vector.reset(seed=3)
     assert observations.shape == (2, *vector.single_observation_space.shape)
@@ -85,7 +88,7 @@ def test_two_async_environments_step_in_subprocesses(robot, task):
     stepped, rewards, terminated, truncated, _ = vector.step(actions)
     assert stepped.shape == observations.shape and np.all(np.isfinite(stepped))
     assert np.all((rewards >= 0) & (rewards <= 1)) and not terminated.any()
-    layout = gymnasium.make(env_id, **SHORT_OPTIONS[task]).unwrapped.observation_layout
+    layout = gymnasium.make(env_id, **short(task)).unwrapped.observation_layout
     assert not np.array_equal(stepped[0, layout["poses"]], stepped[1, layout["poses"]])
   finally:
     vector.close()
@@ -95,7 +98,8 @@ def test_two_async_environments_step_in_subprocesses(robot, task):
 def test_an_episode_ends_truncated_when_its_reference_runs_out(task):
   env = make("tendon-1", task)
   env.reset(seed=0)
-  ends = [env.step(env.action_space.sample())[2:4] for _ in range(env.unwrapped.dm_env.task.num_steps)]
+  steps = env.unwrapped.dm_env.task.num_steps
+  ends = [env.step(env.action_space.sample())[2:4] for _ in range(steps)]
   assert ends[:-1] == [(False, False)] * (len(ends) - 1) and ends[-1] == (False, True)
   with pytest.raises(RuntimeError, match="call reset"):
     env.unwrapped.step(env.action_space.sample())

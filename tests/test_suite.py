@@ -22,10 +22,7 @@ from softbench.data import dataset
 from softbench.robots import recorder
 from softbench.suite import references
 
-# Options that shorten each task's episode; short_env gives `custom` a trajectory of 3 targets.
-SHORT = {"length": 3}
-SHORT_OPTIONS = {"babbling": SHORT, "circle": SHORT, "rectangle": SHORT, "spiral": SHORT,
-                 "reach": {"steps": 2}, "custom": {}}
+SHORT_STEPS = 3  # Control steps of every shortened episode; short_env gives `custom` 3 targets.
 # Every task on every benchmark robot: ALL_TASKS, plus the user's `custom` task.
 EVERY_TASK = tuple((robot, task) for robot in robots.BENCHMARK_ROBOTS for task in suite.TASKS)
 
@@ -40,7 +37,8 @@ def short_env(robot, task, seed=0, **options):
   if task == "custom":
     options = {"trajectory": references.reference(robots.make(robot), "circle", 3).targets,
                **options}
-  return suite.load(robot, task, seed=seed, **{**SHORT_OPTIONS[task], **options})
+  return suite.load(robot, task, seed=seed,
+                    **{**suite.length_options(task, SHORT_STEPS), **options})
 
 
 def random_actions(env, seed=0):

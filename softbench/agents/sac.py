@@ -228,11 +228,11 @@ def train(robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
       model = stable_baselines3.SAC.load(io.BytesIO(state["model"]), env=venv, device=device)
       model.load_replay_buffer(io.BytesIO(state["replay_buffer"]))
       _restore_random_states(model, state["random"])
-      model._last_obs = venv.reset()  # pylint: disable=protected-access
+      model._last_obs = first = venv.reset()  # pylint: disable=protected-access
       _restore_reward_scale(venv, state["reward_scale"])  # After the reset, which zeroes returns.
       if isinstance(venv, vec_env.VecNormalize):
         model._last_original_obs = venv.get_original_obs()  # pylint: disable=protected-access
-      if not np.array_equal(model._last_obs, state["last_observation"]):  # pylint: disable=protected-access
+      if not np.array_equal(first, state["last_observation"]):
         raise RuntimeError(f"{partial}: the resumed episode does not start where the saved "
                            "training stopped; delete the file to train from the start")
       elapsed = state["wall_time_s"]

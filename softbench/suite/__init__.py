@@ -27,7 +27,11 @@ from softbench.suite import references
 from softbench.suite import tracking
 from softbench.suite import trajectories
 
-TaskEntry = collections.namedtuple("TaskEntry", ["build", "tags", "description"])
+TaskEntry = collections.namedtuple(
+    "TaskEntry", ["build", "tags", "description", "paper_robot", "length_option"])
+"""A task of the suite: ``build(robot, random=..., **options)``, its tags, a one-line description,
+the robot it runs on in the paper (the default of ``softbench run --robot``) and the option that
+sets its episode length (None: the user's trajectory does)."""
 
 
 def _reference_task(shape: str) -> Callable[..., base.SoftArmTask]:
@@ -47,19 +51,23 @@ def _custom_task(robot, trajectory=None, initial_actuation: float = base.INITIAL
                            initial_actuation=initial_actuation, random=random)
 
 
+# The paper runs its Exp2S tracking on the tendon arm and its reaching on the pneumatic arm.
 _TASKS = {
     "babbling": TaskEntry(_reference_task("babbling"), ("benchmarking", "tracking"),
-                          "follow held-out poses produced by random actuation"),
+                          "follow held-out poses produced by random actuation", "tendon-3",
+                          "length"),
     "circle": TaskEntry(_reference_task("circle"), ("benchmarking", "tracking"),
-                        "follow a circle traced in actuation space"),
+                        "follow a circle traced in actuation space", "tendon-3", "length"),
     "rectangle": TaskEntry(_reference_task("rectangle"), ("benchmarking", "tracking"),
-                           "follow a rectangle traced in actuation space"),
+                           "follow a rectangle traced in actuation space", "tendon-3", "length"),
     "spiral": TaskEntry(_reference_task("spiral"), ("benchmarking", "tracking"),
-                        "follow a growing spiral traced in actuation space"),
+                        "follow a growing spiral traced in actuation space", "tendon-3", "length"),
     "reach": TaskEntry(reach.Reach, ("benchmarking",),
-                       "bring one module's tip to a virtual point (position only)"),
+                       "bring one module's tip to a virtual point (position only)",
+                       "pneumatic-433", "steps"),
     "custom": TaskEntry(_custom_task, ("tracking", "user"),
-                        "follow your own trajectory (.npy or .csv, one target per row)"),
+                        "follow your own trajectory (.npy or .csv, one target per row)",
+                        "tendon-3", None),
 }
 TASKS = tuple(_TASKS)
 ALL_TASKS = tuple((robot, task) for robot in robots.BENCHMARK_ROBOTS for task in TASKS
@@ -72,6 +80,13 @@ def describe(task: str) -> TaskEntry:
   if task not in _TASKS:
     raise ValueError(f"unknown task {task!r}; choose one of {', '.join(TASKS)}")
   return _TASKS[task]
+
+
+def length_options(task: str, steps: int | None) -> dict:
+  """The options of ``load`` that make ``task``'s episodes ``steps`` control steps long ({} for
+  None, or for ``custom``, whose trajectory sets its length)."""
+  option = describe(task).length_option
+  return {} if steps is None or option is None else {option: steps}
 
 
 def load(robot: str | robots.SoftArm, task: str, seed=None, environment_kwargs: dict | None = None,
@@ -111,4 +126,4 @@ def load(robot: str | robots.SoftArm, task: str, seed=None, environment_kwargs: 
                              **(environment_kwargs or {}))
 
 
-__all__ = ["ALL_TASKS", "BENCHMARKING", "TASKS", "describe", "load"]
+__all__ = ["ALL_TASKS", "BENCHMARKING", "TASKS", "describe", "length_options", "load"]
