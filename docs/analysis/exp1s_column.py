@@ -89,7 +89,8 @@ def main() -> None:
     retrained = dataclasses.replace(model, network=network)
     agent = retrained.agent(args.configuration, args.seed)
     for name in args.tasks:
-      env = suite.load(arm, name, seed=args.seed, **profile.episode_options(name))
+      env = suite.load(arm, name, seed=args.seed,
+                       **suite.length_options(name, profile.episode_length))
       episode = evaluation.run_episode(env, agent, name)
       score = continual._end_effector_scores(episode, arm.length)
       print(f"{label}: {arm.name} {name}, closed loop in physics: end effector "
