@@ -10,6 +10,7 @@ from smpl import snapshots
 from softbench import data
 from softbench import profiles
 from softbench import robots
+from softbench.agents import learned
 from softbench.agents import sac
 from softbench.data import splits
 from softbench.envs import environment
@@ -75,7 +76,7 @@ def test_a_damaged_model_is_reported_and_trained_again(home):
 
 def test_training_episodes_follow_training_stretches_fixed_by_the_seed(home):
   arm = robots.make(ROBOT)
-  dataset = data.collect(ROBOT, samples=TINY.samples, seed=sac.DATA_SEED, progress=False)
+  dataset = data.collect(ROBOT, samples=TINY.samples, seed=learned.DATA_SEED, progress=False)
   stream = streams.training_targets(dataset, 10)
   env = streams.TargetStreamEnv(arm, stream, 10, seed=4)
   later = streams.TargetStreamEnv(arm, stream, 10, seed=4, first_episode=2)

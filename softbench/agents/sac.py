@@ -29,6 +29,7 @@ from softbench import data
 from softbench import profiles
 from softbench import storage
 from softbench.agents import base
+from softbench.agents import learned
 from softbench.data import progress as progress_bars
 from softbench.envs import environment
 from softbench.envs import streams
@@ -54,7 +55,8 @@ HYPERPARAMETERS = {
     "normalise_reward": True,
 }
 TRAINING_VERSION = 1  # Bump when training changes, so that cached models are not reused.
-DATA_SEED = 0  # The babbling dataset every agent learns from (as agents.learned).
+SPENT = ("environment_steps", "episodes", "wall_time_s")  # What a trained model records of its
+# training (training_summary).
 _FORMAT = "softbench-sac"
 
 
@@ -105,7 +107,7 @@ def checkpoint_path(robot: robot_base.SoftArm, seed: int, profile: profiles.Prof
                     ) -> pathlib.Path:
   """Where the trained model of ``seed`` is cached (it exists once trained)."""
   key = training_config(robot, seed, profile).key
-  return storage.softbench_home() / "checkpoints" / f"{key}.pt"
+  return storage.softbench_home() / learned.CHECKPOINT_FOLDER / f"{key}.pt"
 
 
 class _PolicyInput(vec_env.VecEnvWrapper):
@@ -131,7 +133,8 @@ class _PolicyInput(vec_env.VecEnvWrapper):
 
 def _training_env(robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
                   first_episode: int) -> tuple[vec_env.VecEnv, streams.TargetStreamEnv]:
-  dataset = data.collect(robot.name, samples=profile.samples, seed=DATA_SEED, progress=False)
+  dataset = data.collect(robot.name, samples=profile.samples, seed=learned.DATA_SEED,
+                         progress=False)
   stream_env = streams.TargetStreamEnv(robot, streams.training_targets(dataset, EPISODE_STEPS),
                                        EPISODE_STEPS, seed, first_episode)
   venv = vec_env.DummyVecEnv([lambda: stream_env])
@@ -271,8 +274,6 @@ class SACAgent(base.Agent):
 
   def __init__(self, robot: robot_base.SoftArm, seed: int, trained: dict):
     super().__init__(robot, seed)
-    self.training = {key: trained[key] for key in ("environment_steps", "episodes",
-                                                   "wall_time_s")}
     self._model = stable_baselines3.SAC.load(io.BytesIO(trained["model"]), device="cpu")
 
   def reset(self, episode: base.EpisodeInfo) -> None:
@@ -304,5 +305,4 @@ def training_summary(robot: robot_base.SoftArm, seed: int, profile: profiles.Pro
   saved = storage.read_cached(checkpoint_path(robot, seed, profile),
                               lambda file: _read(file, config, "model"), "cached sac model",
                               "training it again")
-  return None if saved is None else {key: saved[key] for key in ("environment_steps", "episodes",
-                                                                   "wall_time_s")}
+  return None if saved is None else {key: saved[key] for key in SPENT}

@@ -24,6 +24,7 @@ from gymnasium import spaces
 from softbench import robots
 from softbench import suite
 from softbench.data import seeding
+from softbench.rendering import live
 from softbench.suite import trajectories
 
 OBSERVATION_FORMS = ("flat", "dict")
@@ -88,14 +89,13 @@ class SoftArmEnv(gymnasium.Env):
                        f"got {render_mode!r}")
     self.robot = robots.make(robot) if isinstance(robot, str) else robot
     self.task_name = task
-    self._task_options = task_options
     self._environment = suite.load(self.robot, task, **task_options)
     self._observation_form = observation
     self.render_mode = render_mode
     self.metadata = {**self.metadata, "render_fps": 1.0 / self.robot.control_timestep}
     named = self._environment.observation_spec()
     action = named["previous_action"]
-    self._named_spaces = {
+    named_spaces = {
         "poses": _pose_box(named["poses"], self.robot),
         "target": _pose_box(named["target"], self.robot),
         "previous_action": spaces.Box(float(action.minimum), float(action.maximum), action.shape,
@@ -103,17 +103,16 @@ class SoftArmEnv(gymnasium.Env):
     self.observation_shapes = {key: tuple(named[key].shape) for key in KEYS}
     self.observation_layout = layout(self.observation_shapes)
     if observation == "dict":
-      self.observation_space = spaces.Dict(self._named_spaces)
+      self.observation_space = spaces.Dict(named_spaces)
     else:
       self.observation_space = spaces.Box(
-          np.concatenate([space.low.ravel() for space in self._named_spaces.values()]),
-          np.concatenate([space.high.ravel() for space in self._named_spaces.values()]),
+          np.concatenate([space.low.ravel() for space in named_spaces.values()]),
+          np.concatenate([space.high.ravel() for space in named_spaces.values()]),
           dtype=np.float64)
     action = self._environment.action_spec()
     self.action_space = spaces.Box(-1.0, 1.0, action.shape, np.float32)
     self._view = None
     if render_mode is not None:
-      from softbench.rendering import live  # pylint: disable=import-outside-toplevel
       self._view = live.LiveView(self.robot, width=width, height=height, camera=camera)
     elif (width, height, camera) != (None, None, None):
       raise ValueError("width, height and camera need render_mode='rgb_array'")

@@ -13,7 +13,6 @@ from softbench.rendering import options as video_options
 from softbench.rendering import replay as episode_replay
 from softbench.rendering import scene
 
-_ROBOT_GEOM_ALLOWANCE = 4  # Scene geoms per model element (bodies, geoms, tendon pieces...).
 
 
 class EpisodeFrames:
@@ -28,8 +27,7 @@ class EpisodeFrames:
     colours = scene.module_colours(model, replay.robot.num_modules)
     self.markers = markers.EpisodeMarkers(replay.episode, colours, replay.robot.length,
                                           scene.arm_radius(model), replay.title)
-    robot_geoms = _ROBOT_GEOM_ALLOWANCE * (model.nbody + model.ngeom + model.nsite + model.nwrap
-                                          + model.ntendon)
+    robot_geoms = scene.robot_geom_budget(model)
     self._camera = engine.Camera(self.physics, options.height, options.width, options.camera,
                                  max_geom=robot_geoms + self.markers.geom_count,
                                  scene_callback=self.markers)

@@ -17,7 +17,6 @@ from softbench.rendering import options as video_options
 from softbench.rendering import scene
 
 _DECORATION_GEOMS = 64  # Scene geoms beyond the robot's: one target marker per scored module.
-_ROBOT_GEOM_ALLOWANCE = 4  # Scene geoms per model element (bodies, geoms, tendon pieces...).
 
 
 class LiveView:
@@ -51,8 +50,7 @@ class LiveView:
     scored = np.array(task.scored_modules()) - 1
     self._colours = scene.module_colours(model, self.robot.num_modules)[scored]
     self._radius = markers.target_radius(self.robot.length, scene.arm_radius(model))
-    geoms = _ROBOT_GEOM_ALLOWANCE * (model.nbody + model.ngeom + model.nsite + model.nwrap
-                                     + model.ntendon) + _DECORATION_GEOMS
+    geoms = scene.robot_geom_budget(model) + _DECORATION_GEOMS
     self._camera = engine.Camera(self._physics, options.height, options.width, options.camera,
                                  max_geom=geoms, scene_callback=self._draw_targets)
     self._view = wrapper.MjvOption()

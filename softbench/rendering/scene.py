@@ -27,6 +27,7 @@ _FLOOR_RGB = ((0.32, 0.34, 0.38), (0.26, 0.28, 0.32))  # Checker squares.
 _FLOOR_SQUARES_PER_ARM_LENGTH = 4
 _SAMPLES = 0  # Multisamples of the off-screen buffer.
 _SLICES = 16  # Slices of round shapes (MuJoCo's default 28).
+_ROBOT_GEOM_ALLOWANCE = 4  # Scene geoms per model element (bodies, geoms, tendon pieces...).
 
 
 def module_colours(model: mujoco.MjModel, num_modules: int) -> np.ndarray:
@@ -125,6 +126,12 @@ def scene_model(robot: base.SoftArm, points: np.ndarray, width: int, height: int
     position, quaternion = camera_pose(camera, points, padding, width / height)
     spec.worldbody.add_camera(name=camera, pos=position, quat=quaternion, fovy=FOVY_DEG)
   return spec.compile()
+
+
+def robot_geom_budget(model: mujoco.MjModel) -> int:
+  """Scene geoms to allow for drawing the robot of ``model`` (bodies, geoms, tendon pieces...)."""
+  return _ROBOT_GEOM_ALLOWANCE * (model.nbody + model.ngeom + model.nsite + model.nwrap
+                                  + model.ntendon)
 
 
 def arm_radius(model: mujoco.MjModel) -> float:
