@@ -11,7 +11,6 @@ compiles), summed over an SMPL network's columns, i.e. what one epoch of every m
 """
 
 import dataclasses
-import importlib
 import pathlib
 import time
 from collections.abc import Iterator
@@ -59,7 +58,7 @@ def test_closed_loop_training_epoch(benchmark, agent: str, robot_name: str) -> N
   robot = robots.make(robot_name)
   paper = profiles.get("paper")
   profile = dataclasses.replace(paper, max_epochs=_EPOCHS, patience=_EPOCHS)
-  learner = importlib.import_module(agents.describe(agent).module).LEARNER
+  learner = agents.learner(agent)
   views = learner.views(robot)
   babbling = _random_babbling(robot, paper.samples)
   windows = [data.windows(babbling, view) for view in views]

@@ -16,11 +16,13 @@ from softbench import continual
 from softbench import data
 from softbench import episode_snapshots
 from softbench import leaderboard
+from softbench import parallel_seeds
 from softbench import plots
 from softbench import profiles
 from softbench import retrain as retrain_module
 from softbench import robots
 from softbench import run as run_module
+from softbench import saving
 from softbench import storage
 from softbench import suite
 from softbench import tuning
@@ -29,12 +31,12 @@ from softbench.adaptive import plot as adaptive_plot
 from softbench.agents import hyperparameters
 from softbench.data import dataset
 from softbench.data import seeding
+from softbench.leaderboard import doc_tables
+from softbench.leaderboard import zoo_catalogue
+from softbench.leaderboard import zoo_verification
 from softbench.rendering import options as video_options
-from softbench.rendering import replay as episode_replay
 from softbench.rendering import video
 from softbench.robots import export as model_export
-from softbench.zoo import catalogue as zoo_catalogue
-from softbench.zoo import verification as zoo_verification
 
 EXIT_USAGE = 2
 _JSON_HELP = "print JSON (for scripts) instead of a table"
@@ -202,17 +204,12 @@ def _run_protocol(args: argparse.Namespace) -> None:
   continual.protocol(family)  # Checked before anything runs.
   record = continual.execute(profile, args.seeds, workers=args.workers, keep_seeds=True,
                              family=family)
-  print(continual.table(record))
-  path = continual.record_path(record, pathlib.Path(args.results))
-  run_module.write_record(record, path)
-  print(f"result record: {path}")
+  path, *_ = saving.save(continual, record, pathlib.Path(args.results), _json_copy(args))
   # Only now: a failed write leaves a run that resumes.
   episode_snapshots.discard_folder(continual.finished_seeds_folder(profile, family))
   heat_map = plots.forgetting_matrix(continual.mean_forgetting(record), record["robots"],
                                      path.with_name(f"{path.stem}-forgetting.png"))
   print(f"plot: {heat_map}")
-  if args.json:
-    run_module.write_record(record, pathlib.Path(args.json))
 
 
 def _number(name: str, text: str, kind: type) -> int | float:
@@ -245,7 +242,7 @@ def _video_flags_given(args: argparse.Namespace) -> list[str]:
 
 def _write_video(settings: run_module.RunSettings, seed: int, episode, path: pathlib.Path,
                  options: video_options.VideoOptions) -> None:
-  stats = video.render(episode_replay.of_run(settings, seed, episode), path, options,
+  stats = video.render(run_module.replay_of(settings, seed, episode), path, options,
                        show_progress=True)
   print(f"video: {stats.path} ({stats.frames} frames, {options.width}x{options.height} at "
         f"{options.fps:g} fps, {stats.frames / options.fps:.1f} s, "
@@ -276,12 +273,8 @@ def _run(args: argparse.Namespace) -> None:
     options = _video_options(args)
     video_path = video_options.check_video_path(args.video)
   record, episodes = run_module.execute_episodes(settings, keep_seeds=True, workers=args.workers)
-  print(run_module.table(record))
-  path = run_module.record_path(record, pathlib.Path(args.results))
-  run_module.write_record(record, path)
-  print(f"result record: {path}")
-  if args.json:
-    run_module.write_record(record, pathlib.Path(args.json))
+  files = saving.save(run_module, record, pathlib.Path(args.results), _json_copy(args))
+  path = files[0]
   episode_snapshots.discard(settings)  # Only now: a failed write leaves a run that resumes.
   if settings.adaptive:
     print(f"plot: {adaptive_plot.write(record, path.with_suffix('.png'))}")
@@ -289,9 +282,7 @@ def _run(args: argparse.Namespace) -> None:
     print(f"plot: {plot}")
   if args.video:  # Once the record is safe; then the record links the video.
     _write_video(settings, 0, episodes[0], video_path, options)
-    for record_file in [path] + ([pathlib.Path(args.json)] if args.json else []):
-      record["video"] = os.path.relpath(video_path.resolve(), record_file.parent.resolve())
-      run_module.write_record(record, record_file)
+    saving.link_video(record, files, video_path)
 
 
 def _render(args: argparse.Namespace) -> None:
@@ -339,6 +330,10 @@ def _add_record_arguments(parser: argparse.ArgumentParser) -> None:
   parser.add_argument("--json", help="also write the result record to this file")
 
 
+def _json_copy(args: argparse.Namespace) -> pathlib.Path | None:
+  return pathlib.Path(args.json) if args.json else None
+
+
 def _check_record_arguments(args: argparse.Namespace) -> None:
   """Refuses a ``--results`` or ``--json`` that could not be written, before the run."""
   storage.check_writable(args.results, "result records to", folder=True)
@@ -351,7 +346,8 @@ def _leaderboard(args: argparse.Namespace) -> None:
   board = leaderboard.build(results)
   print(leaderboard.text.report(board, results))
   if args.write:
-    for path in leaderboard.write(board, results, pathlib.Path(args.out)):
+    for path in [*leaderboard.write(board, results, pathlib.Path(args.out)),
+                 *doc_tables.write(board, results)]:
       print(f"wrote {path}")
 
 
@@ -360,12 +356,7 @@ def _retrain(args: argparse.Namespace) -> None:
                                      args.task, args.seeds, args.baseline)
   _check_record_arguments(args)
   record = retrain_module.execute(settings)
-  print(retrain_module.table(record))
-  path = retrain_module.record_path(record, pathlib.Path(args.results))
-  run_module.write_record(record, path)
-  print(f"result record: {path}")
-  if args.json:
-    run_module.write_record(record, pathlib.Path(args.json))
+  saving.save(retrain_module, record, pathlib.Path(args.results), _json_copy(args))
 
 
 def _zoo_folder(args: argparse.Namespace, create: bool = False) -> pathlib.Path:
@@ -566,7 +557,8 @@ def build_parser() -> argparse.ArgumentParser:
                             help=f"folder of the result records (default "
                                  f"{leaderboard.DEFAULT_RESULTS})")
   board_parser.add_argument("--write", action="store_true",
-                            help="also regenerate README.md and index.html in --out")
+                            help="also regenerate README.md and index.html in --out, and the "
+                                 "results tables of the checkout's README.md and docs/*.md")
   board_parser.add_argument("--out", default=str(leaderboard.DEFAULT_OUT),
                             help=f"folder of the pages (default {leaderboard.DEFAULT_OUT})")
   board_parser.set_defaults(run=_leaderboard)
@@ -665,16 +657,16 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
   except SystemExit as done:  # --help (0), or a malformed command line (one line, 2).
     return done.code
-  run_module.one_line_warnings()
+  parallel_seeds.one_line_warnings()
   try:
-    with run_module.sigterm_as_interrupt():
+    with parallel_seeds.sigterm_as_interrupt():
       if args.command in _CACHING_COMMANDS:  # Before any work: a home that takes no file fails
         storage.check_home()  # at once, not after the first seed.
       args.run(args)
   except (ValueError, FileNotFoundError, FloatingPointError, video.RenderingUnavailable) as error:
     print(f"softbench: error: {dataset.first_line(error)}", file=sys.stderr)
     return EXIT_USAGE
-  except (run_module.WorkerDied, video.RenderingFailed, continual.ForgettingDetected,
+  except (parallel_seeds.WorkerDied, video.RenderingFailed, continual.ForgettingDetected,
           ZooMismatch) as error:
     print(f"softbench: error: {dataset.first_line(error)}", file=sys.stderr)
     return EXIT_FAILURE

@@ -30,8 +30,10 @@ from smpl import protocol as smpl_protocol
 from smpl import training
 from softbench import data
 from softbench import episode_snapshots
+from softbench import episodes
 from softbench import evaluation
 from softbench import metrics
+from softbench import parallel_seeds
 from softbench import profiles
 from softbench import protocols
 from softbench import robots
@@ -40,12 +42,11 @@ from softbench import zoo
 from softbench.agents import hyperparameters
 from softbench.agents import learned
 from softbench.data import dataset
+from softbench.records import provenance
+from softbench.records.exp1s import FORGETTING_TASK, LOOPS, METRICS, PROTOCOL, TASKS
+from softbench.records.exp1s import FORMAT as RECORD_FORMAT
+from softbench.records.exp1s import VERSION as RECORD_VERSION
 
-PROTOCOL = "exp1s"
-TASKS = ("babbling", "circle", "rectangle", "spiral")  # The paper's Exp1S table.
-LOOPS = {"closed": "physics", "open": "open-loop"}  # Table label -> the agent's error source.
-FORGETTING_TASK = "spiral"
-METRICS = ("position_mm", "orientation_deg", "normalised_tip_percent")
 DEFAULT_FAMILY = "tendon"
 
 
@@ -181,7 +182,7 @@ def check_no_forgetting(matrix: np.ndarray) -> None:
             f"though its column is frozen (a defect of softbench; please report it)")
 
 
-def _end_effector_scores(episode: evaluation.Episode, length: float) -> dict:
+def _end_effector_scores(episode: episodes.Episode, length: float) -> dict:
   score = episode.score(length)
   return {name: getattr(score, name)[-1].mean for name in METRICS if getattr(score, name)}
 
@@ -256,8 +257,6 @@ def score_seed(seed: int, profile: profiles.Profile, show_progress: bool,
           "forgetting_tip_percent": physics}
 
 
-RECORD_FORMAT = "softbench-exp1s-result"
-RECORD_VERSION = 2  # 2: sealed with an integrity hash (softbench.leaderboard.exp1s_records).
 
 
 def execute(profile: profiles.Profile, seeds: int | None = None, show_progress: bool = True,
@@ -269,8 +268,8 @@ def execute(profile: profiles.Profile, seeds: int | None = None, show_progress: 
   the seeds still to run; unless ``keep_seeds``, they are discarded at the end (else the caller
   discards them, ``episode_snapshots.discard_folder(finished_seeds_folder(profile, family))``,
   once the record is safely written)."""
-  from softbench import run  # run imports the agents; imported here to keep this module light.
-  started, origin = time.perf_counter(), run.provenance()
+  started = time.perf_counter()
+  origin = provenance.provenance(str(learned.training.default_device()))
   seeds = profile.seeds if seeds is None else seeds
   dataset.check_count("seeds", seeds)
   sequence = protocol(family)
@@ -279,7 +278,7 @@ def execute(profile: profiles.Profile, seeds: int | None = None, show_progress: 
     data.collect(arm, samples=profile.samples, seed=learned.DATA_SEED, progress=show_progress)
   if show_progress:
     episode_snapshots.report_resuming(finished_seeds_folder(profile, family), seeds)
-  per_seed = run.over_seeds(run_seed, seeds, (profile, family), f"smpl {PROTOCOL}",
+  per_seed = parallel_seeds.over_seeds(run_seed, seeds, (profile, family), f"smpl {PROTOCOL}",
                             show_progress, workers)
   if not keep_seeds:
     episode_snapshots.discard_folder(finished_seeds_folder(profile, family))
@@ -344,8 +343,7 @@ def family_of(record: dict) -> str:
 def record_path(record: dict, results: pathlib.Path) -> pathlib.Path:
   """``smpl-exp1s-PROFILE-DATE.json`` on the default family, ``smpl-exp1s-FAMILY-PROFILE-DATE``
   on another."""
-  from softbench import run
   family = family_of(record)
   name = "-".join([f"smpl-{record['protocol']}", *([family] if family != DEFAULT_FAMILY else []),
-                   record["profile"], run.date_stamp(record)])
+                   record["profile"], provenance.date_stamp(record)])
   return results / f"{name}.json"

@@ -24,7 +24,7 @@ import torch
 import smpl
 import softbench
 from smpl import training
-from softbench import evaluation
+from softbench import episodes
 from softbench import storage
 from softbench.data import dataset
 
@@ -104,7 +104,7 @@ def _check_owner(stored: str, path: pathlib.Path) -> None:
     raise ValueError(f"saved for {stored}, not for this run and seed")
 
 
-def save(run, seed: int, episode: evaluation.Episode) -> None:
+def save(run, seed: int, episode: episodes.Episode) -> None:
   """Keeps ``seed``'s finished ``episode`` until the run ends (a failed write only warns)."""
   arrays = {name: np.asarray(getattr(episode, name)) for name in _ARRAYS}
   arrays["scored_modules"] = np.asarray(episode.scored_modules, dtype=int)
@@ -113,17 +113,17 @@ def save(run, seed: int, episode: evaluation.Episode) -> None:
   _keep(_path(run, seed), storage.npz_bytes(arrays), f"seed {seed}", "episode")
 
 
-def load(run, seed: int) -> evaluation.Episode | None:
+def load(run, seed: int) -> episodes.Episode | None:
   """``seed``'s episode saved by an interrupted run of the same settings and code, or None. An
   unreadable or altered file is deleted with a warning (``storage.read_cached``; the seed then
   runs again)."""
-  def read(path: pathlib.Path) -> evaluation.Episode:
+  def read(path: pathlib.Path) -> episodes.Episode:
     arrays = dataset.read_npz(path.read_bytes(), ValueError)
     expected = str(arrays.pop("sha256"))
     if expected != storage.arrays_sha256(arrays):
       raise ValueError("content hash mismatch")
     _check_owner(str(arrays.pop("owner")), path)
-    return evaluation.Episode(run.task, tuple(int(k) for k in arrays["scored_modules"]),
+    return episodes.Episode(run.task, tuple(int(k) for k in arrays["scored_modules"]),
                               *(arrays[name] for name in _ARRAYS))
 
   return storage.read_cached(_path(run, seed), read, "saved episode", f"seed {seed} runs again")

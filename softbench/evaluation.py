@@ -4,30 +4,12 @@ At every control step the agent sees the observation, its action is applied for 
 period, and the pose each scored module reached is compared with the target it was shown.
 """
 
-import dataclasses
-
 import numpy as np
 from dm_control.rl import control
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from softbench import agents
-from softbench import metrics
-
-
-@dataclasses.dataclass(frozen=True)
-class Episode:
-  """What happened in one episode: targets shown and poses reached, step by step."""
-
-  task: str
-  scored_modules: tuple[int, ...]
-  targets: np.ndarray  # (steps, scored modules, 6 or 3)
-  achieved: np.ndarray  # (steps, scored modules, 6)
-  poses: np.ndarray  # (steps + 1, num_modules, 6), every module, the start first
-  actions: np.ndarray  # (steps, action_dim)
-  rewards: np.ndarray  # (steps,)
-
-  def score(self, robot_length: float) -> metrics.TrackingScore:
-    return metrics.score(self.achieved, self.targets, robot_length)
+from softbench import episodes
+from softbench import progress as progress_bars
 
 
 def agent_label(agent: agents.Agent) -> str:
@@ -35,7 +17,7 @@ def agent_label(agent: agents.Agent) -> str:
 
 
 def run_episode(env: control.Environment, agent: agents.Agent, task: str,
-                show_progress: bool = False) -> Episode:
+                show_progress: bool = False) -> episodes.Episode:
   """One episode of ``env`` driven by ``agent``.
 
   Raises:
@@ -47,8 +29,7 @@ def run_episode(env: control.Environment, agent: agents.Agent, task: str,
     agent.bind(env.physics)
   agent.reset(agents.EpisodeInfo(task, scored))
   targets, poses, actions, rewards = [], [time_step.observation["poses"]], [], []
-  progress = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                      TimeElapsedColumn(), disable=not show_progress, transient=True)
+  progress = progress_bars.counting(show_progress, transient=True)
   with progress:
     bar = progress.add_task(f"{agent_label(agent)} on {task}", total=env.task.num_steps)
     while not time_step.last():
@@ -60,5 +41,5 @@ def run_episode(env: control.Environment, agent: agents.Agent, task: str,
       rewards.append(time_step.reward)
       progress.advance(bar)
   poses = np.array(poses)
-  return Episode(task, scored, np.array(targets), poses[1:, np.array(scored) - 1], poses,
+  return episodes.Episode(task, scored, np.array(targets), poses[1:, np.array(scored) - 1], poses,
                  np.array(actions), np.array(rewards))

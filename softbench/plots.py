@@ -20,12 +20,12 @@ from matplotlib import colors as mpl_colors
 from matplotlib import ticker
 from matplotlib.figure import Figure
 
-from softbench import evaluation
+from softbench import episodes
 from softbench import metrics
 from softbench import robots
 from softbench import storage
-from softbench.robots import base
 from softbench.rendering import scene
+from softbench.robots import base
 
 DPI = 110  # (dots per inch) of saved figures.
 PANEL_INCHES = 4.0  # Width and height of one 3-D path panel.
@@ -54,7 +54,7 @@ def _module_colours(robot: base.SoftArm | None, modules: Sequence[int]) -> list:
   return [tuple(colours[module - 1][:3]) for module in modules]
 
 
-def tracking_paths(episode: evaluation.Episode, path: str | pathlib.Path, title: str = "",
+def tracking_paths(episode: episodes.Episode, path: str | pathlib.Path, title: str = "",
                    robot: base.SoftArm | None = None) -> pathlib.Path:
   """Saves target (dashed) and achieved (solid) tip paths in mm, a 3-D panel per scored module,
   starting at the pose before the first step. A target held all episode is drawn as a star.
@@ -92,7 +92,7 @@ def tracking_paths(episode: evaluation.Episode, path: str | pathlib.Path, title:
   return _save(figure, path)
 
 
-def tracking_errors(episodes: Sequence[evaluation.Episode], path: str | pathlib.Path,
+def tracking_errors(episodes: Sequence[episodes.Episode], path: str | pathlib.Path,
                     title: str = "", robot: base.SoftArm | None = None) -> pathlib.Path:
   """Saves position error (mm), and orientation error (deg) for 6-D targets, over control steps:
   a line per module and episode (seed), the first episode's drawn solid, the others fainter."""
@@ -192,7 +192,7 @@ def run_plot_paths(record_path: str | pathlib.Path) -> tuple[pathlib.Path, pathl
 
 
 def save_run_plots(record_path: str | pathlib.Path, record: dict,
-                   episodes: Sequence[evaluation.Episode]) -> tuple[pathlib.Path, pathlib.Path]:
+                   episodes: Sequence[episodes.Episode]) -> tuple[pathlib.Path, pathlib.Path]:
   """Saves the first episode's (seed 0's) tip paths and every episode's errors over time next to
   the result record ``record`` (``softbench.run``): ``<record stem>-paths.png`` and
   ``<record stem>-error.png``."""

@@ -28,6 +28,7 @@ from softbench import robots
 from softbench import run as run_module
 from softbench.agents import adaptation
 from softbench.agents import learned
+from softbench.records import provenance
 from softbench.robots import faults as fault_model
 
 DEFAULT_TASK = "spiral"
@@ -125,7 +126,8 @@ def _seed(settings: RetrainSettings, seed: int, show_progress: bool) -> dict:
 def execute(settings: RetrainSettings, show_progress: bool = True) -> dict:
   """Collects both robots' babbling, runs every seed (one after the other) and returns the
   result record."""
-  started, origin = time.perf_counter(), run_module.provenance()
+  started = time.perf_counter()
+  origin = provenance.provenance(str(learned.training.default_device()))
   run = settings.run
   healthy = robots.make(run.robot)
   faulty = healthy.with_faults(run.faults)

@@ -13,45 +13,33 @@ With ``faults`` (``--fault MODULE:ACTUATOR:GAIN``, ``softbench.robots.faults``) 
 built for the healthy robot, as a deployed controller would be, and evaluated on the faulty one.
 """
 
-from collections.abc import Iterator
-from concurrent import futures
-import contextlib
 import dataclasses
-import datetime
-import multiprocessing
-import os
 import pathlib
-import platform
-import signal
-import subprocess
-import threading
 import time
-import warnings
 
-import torch
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-
-import softbench
 from softbench import adaptive as adaptive_activation
 from softbench import agents
 from softbench import data
 from softbench import episode_snapshots
+from softbench import episodes
 from softbench import evaluation
 from softbench import metrics
+from softbench import parallel_seeds
 from softbench import profiles
+from softbench import records
 from softbench import robots
 from softbench import suite
 from softbench import zoo
 from softbench.agents import learned
 from softbench.data import dataset
-from softbench.leaderboard import records
+from softbench.records import provenance
+from softbench.rendering import replay
+from softbench.robots import faults as fault_model
 from softbench.suite import reach
 from softbench.suite import trajectories
-from softbench.robots import faults as fault_model
 
 METRICS = (("position_mm", "position (mm)"), ("orientation_deg", "orientation (deg)"),
            ("normalised_tip_percent", "tip error (%)"))
-_POLL_SECONDS = 0.2  # (s) How often the parent looks at its worker processes.
 RECORD_FORMAT = records.FORMAT
 RECORD_VERSION = records.VERSION
 
@@ -143,6 +131,14 @@ def task_options(run: RunSettings) -> dict:
   return {**options, **suite.length_options(run.task, run.profile.episode_length)}
 
 
+def replay_of(run: RunSettings, seed: int, episode: episodes.Episode) -> replay.Replay:
+  """The replay of ``episode``, seed ``seed`` of ``run``, for videos."""
+  feedback = "" if run.eval_mode == "physics" else f", eval {run.eval_mode}"
+  return replay.Replay(robots.make(run.robot), run.task, seed, task_options(run), episode,
+                       f"{run.agent} on {run.task} ({run.robot}) seed {seed}, "
+                       f"{run.profile.name} profile{feedback}")
+
+
 def _seed_scores(score: metrics.TrackingScore) -> dict:
   """Per-module means over the episode's steps, and their average over modules."""
   result = {}
@@ -155,41 +151,8 @@ def _seed_scores(score: metrics.TrackingScore) -> dict:
   return result
 
 
-def _git_commit() -> str | None:
-  try:
-    commit = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
-                            check=True, cwd=pathlib.Path(__file__).parent).stdout.strip()
-    dirty = subprocess.run(["git", "status", "--porcelain"], capture_output=True, text=True,
-                           check=True, cwd=pathlib.Path(__file__).parent).stdout.strip()
-  except (OSError, subprocess.CalledProcessError):
-    return None
-  return commit + ("-dirty" if dirty else "")
-
-
-def _machine() -> dict:
-  return {"platform": platform.platform(), "processor": _processor(),
-          "cpu_count": os.cpu_count(), "python": platform.python_version(),
-          "torch": torch.__version__, "device": str(learned.training.default_device())}
-
-
-def _processor() -> str:
-  """The CPU's model name where Linux tells it (``platform.processor()`` is empty there), else
-  what ``platform`` knows; with ``avx512``/``avx2`` added where Linux lists those flags, since
-  libraries that pick kernels by CPU (OpenBLAS, oneDNN) round differently with them."""
-  try:
-    cpuinfo = pathlib.Path("/proc/cpuinfo").read_text()
-  except OSError:
-    return platform.processor() or platform.machine()
-  fields = dict(line.split(":", 1) for line in cpuinfo.splitlines() if ":" in line)
-  fields = {key.strip(): value.strip() for key, value in fields.items()}
-  name = fields.get("model name") or platform.processor() or platform.machine()
-  flags = fields.get("flags", "").split()
-  widest = next((kind for kind in ("avx512f", "avx2") if kind in flags), None)
-  return f"{name} ({widest.removesuffix('f')})" if widest else name
-
-
 def episode_on(agent: agents.Agent, arm: robots.SoftArm, run: RunSettings, seed: int,
-               show_progress: bool = False) -> evaluation.Episode:
+               show_progress: bool = False) -> episodes.Episode:
   """One episode of ``run``'s task (environment seed ``seed``) by ``agent`` on ``arm``, which may
   be a faulty robot."""
   if isinstance(agent, learned.LearnedAgent):
@@ -198,7 +161,7 @@ def episode_on(agent: agents.Agent, arm: robots.SoftArm, run: RunSettings, seed:
   return evaluation.run_episode(env, agent, run.task, show_progress)
 
 
-def seed_entry(seed: int, episode: evaluation.Episode, arm: robots.SoftArm) -> dict:
+def seed_entry(seed: int, episode: episodes.Episode, arm: robots.SoftArm) -> dict:
   """The record's entry of one seed's episode."""
   return {"seed": seed, "steps": len(episode.actions),
           "mean_reward": float(episode.rewards.mean()),
@@ -212,14 +175,14 @@ def evaluate(agent: agents.Agent, arm: robots.SoftArm, run: RunSettings, seed: i
   return seed_entry(seed, episode, arm), episode.scored_modules
 
 
-def seed_episode(run: RunSettings, seed: int, show_progress: bool = False) -> evaluation.Episode:
+def seed_episode(run: RunSettings, seed: int, show_progress: bool = False) -> episodes.Episode:
   """Builds (trains) the agent of ``seed`` for the healthy robot, as a deployed controller would
   be, and runs it through one episode on the robot with ``run.faults``."""
   return _episode_and_arm(run, seed, show_progress)[0]
 
 
 def _episode_and_arm(run: RunSettings, seed: int, show_progress: bool
-                     ) -> tuple[evaluation.Episode, robots.SoftArm]:
+                     ) -> tuple[episodes.Episode, robots.SoftArm]:
   """``seed_episode``, and the (faulty) robot it ran on."""
   arm = robots.make(run.robot)
   agent = agents.make(run.agent, arm, seed, run.profile, show_progress)
@@ -234,7 +197,7 @@ def score_seed(run: RunSettings, seed: int) -> dict:
 
 
 def _run_seed(seed: int, run: RunSettings,
-              show_progress: bool) -> tuple[dict, evaluation.Episode]:
+              show_progress: bool) -> tuple[dict, episodes.Episode]:
   """The episode of ``seed`` (``seed_episode``, or the one an interrupted run of the same
   settings and code saved) and its record entry; a new episode is saved at once."""
   episode = episode_snapshots.load(run, seed)
@@ -247,109 +210,6 @@ def _run_seed(seed: int, run: RunSettings,
   return entry, episode
 
 
-def one_line_warnings() -> None:
-  """Prints warnings as ``softbench: warning: MESSAGE``, without file, line and source."""
-  warnings.formatwarning = lambda message, *_, **__: f"softbench: warning: {message}\n"
-
-
-def _interrupt(signal_number: int, frame) -> None:
-  raise KeyboardInterrupt
-
-
-@contextlib.contextmanager
-def sigterm_as_interrupt() -> Iterator[None]:
-  """Within the block (in the main thread), ``kill`` stops softbench as Ctrl-C does: the seed
-  workers are terminated rather than left running without their parent."""
-  if threading.current_thread() is not threading.main_thread():
-    yield
-    return
-  previous = signal.signal(signal.SIGTERM, _interrupt)
-  try:
-    yield
-  finally:
-    signal.signal(signal.SIGTERM, previous)
-
-
-def _init_worker() -> None:
-  """Worker initialiser: one torch thread (the workers fill the cores; torch's default, one thread
-  per core in every worker, made a BiLSTM's evaluation step 450 times slower, 930 ms against 2 ms,
-  with the cores busy); Ctrl-C reaches the parent only, which stops the workers itself; warnings
-  print as in the parent."""
-  torch.set_num_threads(learned.training.CPU_THREADS)
-  signal.signal(signal.SIGINT, signal.SIG_IGN)
-  one_line_warnings()
-
-
-class WorkerDied(RuntimeError):
-  """A worker process ended without a result (killed, or out of memory)."""
-
-
-def _parallel(function, arguments: list[tuple], label: str, workers: int) -> list:
-  """``function(*args)`` for each entry of ``arguments`` in ``workers`` processes (one torch and
-  MuJoCo thread each), with one progress bar; results in order.
-
-  A worker's exception is raised here. On Ctrl-C, or when a worker dies, the workers are
-  terminated; seeds whose checkpoints were written are reused by the next run.
-
-  Raises:
-    WorkerDied: a worker process ended without a result.
-  """
-  progress = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                      TimeElapsedColumn())
-  executor = futures.ProcessPoolExecutor(workers, multiprocessing.get_context("spawn"),
-                                         initializer=_init_worker)
-  try:
-    with progress:
-      bar = progress.add_task(f"{label} ({workers} processes)", total=len(arguments))
-      pending = [executor.submit(function, *entry) for entry in arguments]
-      while futures.wait(pending, _POLL_SECONDS, futures.FIRST_EXCEPTION).not_done:
-        progress.update(bar, completed=sum(future.done() for future in pending))
-        if any(future.done() and future.exception() for future in pending):
-          break
-      outcomes = [future.result() for future in pending]  # Re-raises a worker's error.
-      progress.update(bar, completed=len(arguments))
-  except futures.process.BrokenProcessPool:
-    _terminate(executor)
-    raise WorkerDied(f"a worker process of {label} ended without a result (killed, or out of "
-                     f"memory?); run the same command again to resume") from None
-  except BaseException:  # A worker's error, or Ctrl-C: the other workers stop at once.
-    _terminate(executor)
-    raise
-  # Idle workers exit on their own, so that their clean-up runs (terminating them would leak
-  # the semaphores of torch.compile's worker pools).
-  executor.shutdown(wait=True)
-  return outcomes
-
-
-def _terminate(executor: futures.ProcessPoolExecutor) -> None:
-  """Stops the executor's workers, busy or not, and waits for them."""
-  for process in multiprocessing.active_children():  # The executor's workers.
-    process.terminate()
-  executor.shutdown(wait=True, cancel_futures=True)
-
-
-def over_seeds(function, seeds: int, arguments: tuple, label: str, show_progress: bool,
-                workers: int | None) -> list:
-  """``function(seed, *arguments, show)`` for seeds 0..seeds-1, in ``workers`` processes (default:
-  one per core), never more than there are seeds; each seed computes with
-  ``smpl.training.CPU_THREADS`` torch threads, in this process or a worker."""
-  if workers is not None:
-    dataset.check_count("workers", workers)
-  workers = min(seeds, workers or os.cpu_count() or 1)
-  if workers > 1:
-    return _parallel(function, [(seed, *arguments, False) for seed in range(seeds)],
-                     f"{label}: seeds", workers)
-  with learned.training.limited_cpu_threads(learned.training.CPU_THREADS, torch.device("cpu")):
-    return [function(seed, *arguments, show_progress) for seed in range(seeds)]
-
-
-def provenance() -> dict:
-  """Where and with what a run ran; taken when it starts (the code may change while it runs)."""
-  return {"softbench_version": softbench.__version__, "git_commit": _git_commit(),
-          "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-          "machine": _machine()}
-
-
 def execute(run: RunSettings, show_progress: bool = True, workers: int | None = None) -> dict:
   """Runs every seed, in parallel processes on every core, and returns the result record.
 
@@ -359,7 +219,7 @@ def execute(run: RunSettings, show_progress: bool = True, workers: int | None = 
 
 
 def execute_episodes(run: RunSettings, show_progress: bool = True, workers: int | None = None,
-                     keep_seeds: bool = False) -> tuple[dict, list[evaluation.Episode]]:
+                     keep_seeds: bool = False) -> tuple[dict, list[episodes.Episode]]:
   """``execute``, also returning every seed's episode (in seed order) for plots and videos;
   a learned agent's checkpoints that the data home lacks are taken from the zoo where it holds
   them (``softbench.zoo``; the record then names them in a ``zoo`` section), and the babbling
@@ -367,7 +227,8 @@ def execute_episodes(run: RunSettings, show_progress: bool = True, workers: int 
   none for an adaptive run (``softbench.adaptive`` draws its own figure). The finished seeds
   kept for resuming are discarded at the end unless ``keep_seeds``: then the caller discards
   them (``episode_snapshots.discard``) once the record is safely written."""
-  started, origin = time.perf_counter(), provenance()
+  started = time.perf_counter()
+  origin = provenance.provenance(str(learned.training.default_device()))
   arm = robots.make(run.robot)
   taken = []
   learner = agents.learner(run.agent)
@@ -389,7 +250,7 @@ def execute_episodes(run: RunSettings, show_progress: bool = True, workers: int 
   else:
     if show_progress:
       episode_snapshots.report_resuming(episode_snapshots.folder(run), run.seeds)
-    outcomes = over_seeds(_run_seed, run.seeds, (run,), f"{run.agent} on {run.task}",
+    outcomes = parallel_seeds.over_seeds(_run_seed, run.seeds, (run,), f"{run.agent} on {run.task}",
                           show_progress, workers)
     if not keep_seeds:
       episode_snapshots.discard(run)
@@ -444,21 +305,9 @@ def table(record: dict) -> str:
   return "\n".join(lines)
 
 
-def date_stamp(record: dict) -> str:
-  """The record's date as it appears in file names, e.g. 2026-11-24T013000Z."""
-  return record["date"].replace(":", "").replace("+0000", "Z")
-
-
 def record_path(record: dict, results: pathlib.Path) -> pathlib.Path:
   task = record["task"] + ("-adaptive" if "adaptive" in record else "")
   faulty = "".join(f"-fault{fault['module']}.{fault['actuator']}.{fault['gain']:g}"
                    for fault in record.get("faults") or [])
   return results / (f"{record['agent']}-{record['robot']}{faulty}-{task}-{record['profile']}-"
-                    f"{record['eval_mode']}-{date_stamp(record)}.json")
-
-
-def write_record(record: dict, path: pathlib.Path) -> dict:
-  """Checks ``record`` against the schema of its format (a run's, or Exp1S's), seals it with its
-  integrity hash and writes it atomically (``leaderboard.records.write``); returns the sealed
-  record."""
-  return records.write(record, path)
+                    f"{record['eval_mode']}-{provenance.date_stamp(record)}.json")

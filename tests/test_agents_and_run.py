@@ -14,6 +14,7 @@ from softbench import agents
 from softbench import cli
 from softbench import data
 from softbench import evaluation
+from softbench import parallel_seeds
 from softbench import profiles
 from softbench import protocols
 from softbench import robots
@@ -234,8 +235,8 @@ def test_the_worker_count_changes_no_result(tmp_path, monkeypatch):
     asked.append(args[-1])  # The worker count.
     return over_all_seeds(*args)
 
-  over_all_seeds = run.over_seeds
-  monkeypatch.setattr(run, "over_seeds", over_seeds)
+  over_all_seeds = parallel_seeds.over_seeds
+  monkeypatch.setattr(parallel_seeds, "over_seeds", over_seeds)
   records = []
   for workers in ("1", "3"):  # 3 workers for 2 seeds: 2 processes.
     path = tmp_path / f"workers{workers}.json"
@@ -376,7 +377,7 @@ def test_help_still_prints_the_usage(capsys):
 
 def test_warnings_print_on_one_line(monkeypatch):
   monkeypatch.setattr(warnings, "formatwarning", warnings.formatwarning)  # Restored afterwards.
-  run.one_line_warnings()
+  parallel_seeds.one_line_warnings()
   assert warnings.formatwarning("snapshot unreadable", RuntimeWarning, "training.py", 215,
                                 "saved = load()") == "softbench: warning: snapshot unreadable\n"
 

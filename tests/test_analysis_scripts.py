@@ -1,4 +1,4 @@
-"""The scripts behind README figures (docs/analysis) keep running against the current API, on tiny
+"""The scripts behind the docs' figures (docs/analysis) keep running against the current API, on tiny
 data; the early-stopping script's best-validation agent is the one `softbench run` trains."""
 
 import importlib.util

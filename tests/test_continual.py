@@ -11,9 +11,9 @@ from softbench import continual
 from softbench import data
 from softbench import episode_snapshots
 from softbench import profiles
+from softbench import records
 from softbench import robots
 from softbench.agents import learned
-from softbench.leaderboard import records
 
 
 @pytest.mark.parametrize("family", robots.TENDON_FAMILIES)

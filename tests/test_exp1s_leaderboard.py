@@ -20,12 +20,12 @@ from softbench import continual
 from softbench import leaderboard
 from softbench import metrics
 from softbench import profiles
+from softbench import records
 from softbench import robots
 from softbench import run
 from softbench.leaderboard import exp1s_board
-from softbench.leaderboard import exp1s_records
 from softbench.leaderboard import html_page
-from softbench.leaderboard import records
+from softbench.records import exp1s as exp1s_records
 
 ROBOTS = tuple(f"tendon-{n}" for n in range(1, 6))
 DATE = "2026-01-02T03:04:05+00:00"
@@ -77,7 +77,7 @@ def write_raw(record: dict, path: pathlib.Path, reseal: bool = True) -> pathlib.
 def test_exp1s_schema_round_trip(tmp_path):
   record = exp1s_record()
   path = tmp_path / "exp1s.json"
-  sealed = run.write_record(record, path)  # The path softbench run --protocol exp1s takes.
+  sealed = records.write(record, path)  # The path softbench run --protocol exp1s takes.
   assert sealed[records.INTEGRITY_FIELD] == records.content_sha256(record)
   assert path.read_text() == records.dumps(sealed)
   assert records.read(path) == sealed
@@ -206,7 +206,7 @@ def test_writing_refuses_a_malformed_exp1s_record(tmp_path):
   record = exp1s_record()
   _drop_configuration(record)
   with pytest.raises(records.RecordError, match="has 4 entries for 5 configurations"):
-    run.write_record(record, tmp_path / "record.json")
+    records.write(record, tmp_path / "record.json")
   assert not list(tmp_path.iterdir())
 
 
@@ -256,7 +256,7 @@ def results(run_record, tmp_path) -> pathlib.Path:
       "run.json": run_record,
   }
   for name, record in made.items():
-    run.write_record(record, folder / name)
+    records.write(record, folder / name)
   return folder
 
 

@@ -19,10 +19,10 @@ from scipy import stats
 from softbench import agents
 from softbench import cli
 from softbench import leaderboard
+from softbench import records
 from softbench import run
 from softbench.leaderboard import overview
 from softbench.leaderboard import ranking
-from softbench.leaderboard import records
 
 
 @pytest.fixture(scope="module")
@@ -75,7 +75,7 @@ def write_raw(record: dict, path: pathlib.Path, reseal: bool = True) -> pathlib.
 
 def test_schema_round_trip(real_record, tmp_path):
   path = tmp_path / "record.json"
-  sealed = run.write_record(real_record, path)
+  sealed = records.write(real_record, path)
   assert sealed[records.INTEGRITY_FIELD] == records.content_sha256(real_record)
   assert path.read_text() == records.dumps(sealed)
   assert records.read(path) == sealed
@@ -148,7 +148,7 @@ def test_a_malformed_or_edited_record_is_refused_with_one_line(case, real_record
 
 
 def test_the_cli_refuses_a_folder_with_a_bad_record(real_record, tmp_path, capsys):
-  run.write_record(real_record, tmp_path / "good.json")
+  records.write(real_record, tmp_path / "good.json")
   bad = records.seal(real_record)
   _tamper(bad)
   write_raw(bad, tmp_path / "edited.json", reseal=False)
@@ -180,7 +180,7 @@ def test_an_unparsable_record_is_refused_with_one_line_naming_it(case, tmp_path,
 
 
 def test_a_broken_link_is_refused_as_one(real_record, tmp_path, capsys):
-  run.write_record(real_record, tmp_path / "good.json")
+  records.write(real_record, tmp_path / "good.json")
   (tmp_path / "gone.json").symlink_to(tmp_path / "nowhere.json")
   assert cli.main(["leaderboard", "--results", str(tmp_path)]) == cli.EXIT_USAGE
   (line,) = capsys.readouterr().err.splitlines()
@@ -191,7 +191,7 @@ def test_a_broken_link_is_refused_as_one(real_record, tmp_path, capsys):
 
 def test_an_unreadable_results_folder_is_an_error_not_an_empty_one(real_record, tmp_path,
                                                                      monkeypatch, capsys):
-  run.write_record(real_record, tmp_path / "good.json")
+  records.write(real_record, tmp_path / "good.json")
   scandir = os.scandir
 
   def forbidden(path=".", *args):
@@ -211,7 +211,7 @@ def test_run_refuses_to_write_a_malformed_record(real_record, tmp_path):
   record = copy.deepcopy(real_record)
   record["per_seed"][0]["position_mm"]["mean"] = math.inf
   with pytest.raises(records.RecordError, match="not a finite number"):
-    run.write_record(record, tmp_path / "record.json")
+    records.write(record, tmp_path / "record.json")
   assert not list(tmp_path.iterdir())
 
 
@@ -247,7 +247,7 @@ def results(real_record, tmp_path) -> pathlib.Path:
       "fault.json": variant(real_record, fault={"module": 1, "kind": "dead"}),
   }
   for name, record in made.items():
-    run.write_record(record, folder / name)
+    records.write(record, folder / name)
   return folder
 
 
@@ -271,9 +271,9 @@ def test_an_agent_that_learns_by_acting_shows_its_steps_and_ranks_with_the_other
                          "wall_time_s": 1500.0},
                         {"seed": 1, "environment_steps": 30000, "episodes": 601,
                          "wall_time_s": 2100.0}]}
-  run.write_record(variant(real_record, agent="sac", scale=0.5, training=spent),
+  records.write(variant(real_record, agent="sac", scale=0.5, training=spent),
                    folder / "sac.json")
-  run.write_record(variant(real_record, zoo={"files": ["checkpoints/x.pt"]}), folder / "zero.json")
+  records.write(variant(real_record, zoo={"files": ["checkpoints/x.pt"]}), folder / "zero.json")
   (circle,) = leaderboard.build(folder).groups  # Neither section makes a group of its own.
   assert [entry.shown_setting for entry in circle.entries] == [
       ("sac (30,000 steps, 30 min per seed)", "tiny", "physics"), ("zero", "tiny", "physics")]
@@ -313,7 +313,7 @@ def test_the_overview_shows_the_papers_value_beside_ours(real_record, tmp_path):
   assert overview.paper_mean("tendon-3", "spiral", "zero") is None
   folder = tmp_path / "results"
   for robot in experiments:
-    run.write_record(variant(real_record, agent="smpl", robot=robot), folder / f"{robot}.json")
+    records.write(variant(real_record, agent="smpl", robot=robot), folder / f"{robot}.json")
   views = overview.overviews(leaderboard.build(folder))
   assert [view.robot for view in views] == ["pneumatic-433", "tendon-3"]
   for view, name in zip(views, ("Exp2R", "Exp2S")):

@@ -11,7 +11,7 @@ import time
 import pytest
 import torch
 
-from softbench import run
+from softbench import parallel_seeds
 
 CHILD_DEADLINE_S = 60  # (s) A child program still running after this has hung.
 
@@ -29,7 +29,7 @@ def die(value):
 
 
 def test_results_come_back_in_order():
-  assert run._parallel(square, [(3,), (1,), (2,)], "squares", workers=2) == [9, 1, 4]
+  assert parallel_seeds.in_processes(square, [(3,), (1,), (2,)], "squares", workers=2) == [9, 1, 4]
 
 
 def torch_threads(_):
@@ -38,12 +38,12 @@ def torch_threads(_):
 
 def test_every_seed_runs_one_torch_thread():
   # Torch's default is one thread per core in every worker, which oversubscribes the cores.
-  assert run._parallel(torch_threads, [(0,), (1,)], "threads", workers=2) == [1, 1]
+  assert parallel_seeds.in_processes(torch_threads, [(0,), (1,)], "threads", workers=2) == [1, 1]
   before = torch.get_num_threads()
   torch.set_num_threads(2)
   try:  # In this process (one worker), for the seeds only.
-    assert run.over_seeds(lambda seed, show: torch_threads(seed), 2, (), "threads", False,
-                          workers=1) == [1, 1]
+    assert parallel_seeds.over_seeds(lambda seed, show: torch_threads(seed), 2, (), "threads",
+                                     False, workers=1) == [1, 1]
     assert torch.get_num_threads() == 2
   finally:
     torch.set_num_threads(before)
@@ -51,17 +51,17 @@ def test_every_seed_runs_one_torch_thread():
 
 def test_a_worker_error_is_raised():
   with pytest.raises(ValueError, match="bad seed"):
-    run._parallel(fail, [(1,), (2,)], "failing", workers=2)
+    parallel_seeds.in_processes(fail, [(1,), (2,)], "failing", workers=2)
 
 
 _DYING_PROGRAM = """
 import sys
 sys.path.insert(0, {tests!r})
-from softbench import run
+from softbench import parallel_seeds
 import test_parallel_seeds
 try:
-  run._parallel(test_parallel_seeds.die, [(1,), (2,)], "dying", workers=2)
-except run.WorkerDied as error:
+  parallel_seeds.in_processes(test_parallel_seeds.die, [(1,), (2,)], "dying", workers=2)
+except parallel_seeds.WorkerDied as error:
   print("reported:", error)
 """
 
@@ -80,11 +80,11 @@ import signal, sys, time
 # non-interactive shell, which leaves SIGINT ignored in every process it starts.
 signal.signal(signal.SIGINT, signal.default_int_handler)
 sys.path.insert(0, {tests!r})
-from softbench import run
+from softbench import parallel_seeds
 import test_parallel_seeds
 try:
-  with run.sigterm_as_interrupt():  # As softbench.cli.main runs every command.
-    run._parallel(test_parallel_seeds.sleep_long, [(0,), (1,)], "sleepers", workers=2)
+  with parallel_seeds.sigterm_as_interrupt():  # As softbench.cli.main runs every command.
+    parallel_seeds.in_processes(test_parallel_seeds.sleep_long, [(0,), (1,)], "sleepers", workers=2)
 except KeyboardInterrupt:
   import multiprocessing
   print("children left:", len(multiprocessing.active_children()), flush=True)
@@ -117,9 +117,10 @@ def test_ctrl_c_or_kill_stops_every_worker(stop):
 _COMPILING_PROGRAM = """
 import sys
 sys.path.insert(0, {tests!r})
-from softbench import run
+from softbench import parallel_seeds
 import test_parallel_seeds
-print(run._parallel(test_parallel_seeds.compiled_double, [(1.0,), (2.0,)], "compiling", workers=2))
+print(parallel_seeds.in_processes(test_parallel_seeds.compiled_double, [(1.0,), (2.0,)],
+                                  "compiling", workers=2))
 """
 
 

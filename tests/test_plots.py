@@ -12,8 +12,8 @@ from softbench import agents
 from softbench import cli
 from softbench import evaluation
 from softbench import plots
+from softbench import records
 from softbench import suite
-from softbench.leaderboard import records
 
 
 @pytest.fixture(autouse=True)

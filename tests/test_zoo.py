@@ -13,11 +13,11 @@ from softbench import cli
 from softbench import evaluation
 from softbench import profiles
 from softbench import protocols
+from softbench import records
 from softbench import suite
 from softbench import zoo
 from softbench.agents import learned
-from softbench.leaderboard import records
-from softbench.zoo import catalogue
+from softbench.leaderboard import zoo_catalogue as catalogue
 
 LEARNED_AGENTS = agents.babbling_learners()  # The agents whose weights the zoo keeps.
 ROBOT = "tendon-2"

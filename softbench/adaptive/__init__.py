@@ -14,10 +14,10 @@ Every learned agent can take part: inactive modules get zero actuation (``Learne
 computes every output, masked the same way.
 """
 
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from softbench import agents
 from softbench import profiles
+from softbench import progress as progress_bars
 from softbench import robots
 from softbench.adaptive import experiment
 from softbench.adaptive import procedure
@@ -48,8 +48,7 @@ def run(robot: str, agent: str, profile: profiles.Profile, targets: int = DEFAUL
   learner.error_source = eval_mode
   stages = experiment.timing(arm, profile)
   threshold = experiment.threshold_mm(arm, module)
-  progress = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                      TimeElapsedColumn(), disable=not show_progress, transient=True)
+  progress = progress_bars.counting(show_progress, transient=True)
   with progress:
     bar = progress.add_task(f"adaptive {agent} on {robot}: targets", total=targets)
     outcomes = experiment.reach_targets(learner, arm, targets, module, stages, threshold,

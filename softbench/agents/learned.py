@@ -56,9 +56,10 @@ from softbench import zoo
 from softbench.agents import base
 from softbench.agents import forward_models
 from softbench.agents import hyperparameters
+from softbench.agents import learners
+from softbench.records.fields import ERROR_SOURCES
 from softbench.robots import base as robot_base
 
-ERROR_SOURCES = ("physics", "model", "open-loop")
 HELPER_TARGETS = ("hold", "share")
 CHECKPOINT_FOLDER = "checkpoints"
 DATA_SEED = 0  # Every agent and seed learns from the same babbling dataset.
@@ -68,20 +69,6 @@ TRAINING_VERSION = 3  # Bump when training changes, so cached checkpoints are no
 
 ModelFactory = Callable[..., InverseModel]  # (input_size, action_size, **model settings) -> model
 EpochCallback = Callable[[int, float], None]  # (epoch, counted across columns; validation loss)
-
-
-@dataclasses.dataclass(frozen=True)
-class Learner:
-  """How a learned agent's inverse model is made: one progressive column per module
-  (``per_module``), or one centralised model of the whole arm from ``make_model``."""
-
-  name: str
-  per_module: bool
-  make_model: ModelFactory | None = None
-
-  def views(self, robot: robot_base.SoftArm) -> list[data.View]:
-    return ([data.View.module(robot, k) for k in range(1, robot.num_modules + 1)]
-            if self.per_module else [data.View.whole_arm(robot)])
 
 
 @dataclasses.dataclass(frozen=True)
@@ -376,7 +363,7 @@ def trained_config(name: str, robot: robot_base.SoftArm, views: list[data.View],
 def checkpoint_path(name: str, robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
                     per_module: bool) -> pathlib.Path:
   """Where ``build_agent`` caches the agent's checkpoint (it exists once trained)."""
-  views = Learner(name, per_module).views(robot)
+  views = learners.views(robot, per_module)
   return checkpoint_file(trained_config(name, robot, views, seed, profile,
                                         hyperparameters.values(name, robot.name)))
 
@@ -385,7 +372,7 @@ def cache_files(name: str, robot: robot_base.SoftArm, seed: int, profile: profil
                 per_module: bool) -> list[tuple[pathlib.Path, str]]:
   """The files the data home caches for agent ``name`` of ``seed``, each with its zoo kind: the
   agent's checkpoint, then the forward models it trains through."""
-  views = Learner(name, per_module).views(robot)
+  views = learners.views(robot, per_module)
   forwards = forward_models.configs(robot, views, profile.samples, DATA_SEED,
                                     forward_config(seed, profile), TRAINING_VERSION)
   return ([(checkpoint_path(name, robot, seed, profile, per_module), "agent")]
@@ -454,7 +441,7 @@ def build_agent(name: str, robot: robot_base.SoftArm, seed: int, profile: profil
                 per_module: bool, make_model: ModelFactory | None = None,
                 show_progress: bool = False) -> LearnedAgent:
   """A trained learned agent: from the checkpoint cache, or trained now and then cached."""
-  views = Learner(name, per_module, make_model).views(robot)
+  views = learners.views(robot, per_module)
   params = hyperparameters.values(name, robot.name)
   config = trained_config(name, robot, views, seed, profile, params)
 

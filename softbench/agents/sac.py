@@ -35,7 +35,6 @@ from softbench.envs import environment
 from softbench.envs import streams
 from softbench.robots import base as robot_base
 
-LEARNER = None  # Not trained on babbling through smpl.training (agents.learner).
 EPISODE_STEPS = 50  # Control steps (targets) per training episode.
 STEPS = {"paper": 300_000, "default": 30_000, "tiny": 100}  # Environment steps per profile.
 LEARNING_STARTS = {"paper": 5_000, "default": 2_000, "tiny": 50}  # Random steps before learning.

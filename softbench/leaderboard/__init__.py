@@ -6,16 +6,17 @@ and checks), ``ranking`` (newest record per agent, profile and eval mode; mean, 
 bootstrap interval over seeds), ``overview`` (every agent on every task of a robot, beside the
 paper's Exp2S/Exp2R values), ``exp1s_board`` (Exp1S records in the paper's layout, beside the
 paper's values), ``figure_table`` (the tables every page renders alike), ``text`` (the printout),
-``markdown_page`` and ``html_page`` (``README.md`` and ``index.html``).
+``markdown_page`` and ``html_page`` (``README.md`` and ``index.html``), ``doc_tables`` (the
+results tables of the repository's ``README.md`` and ``docs/*.md``).
 """
 
 import pathlib
 
+from softbench import records
 from softbench import storage
 from softbench.leaderboard import html_page
 from softbench.leaderboard import markdown_page
 from softbench.leaderboard import ranking
-from softbench.leaderboard import records
 from softbench.leaderboard import text
 
 DEFAULT_RESULTS = records.DEFAULT_FOLDER

@@ -18,13 +18,12 @@ import dataclasses
 import pathlib
 import re
 
-from softbench import continual
 from softbench import metrics
-from softbench.leaderboard import exp1s_records
-from softbench.leaderboard.figure_table import Table
+from softbench import records
 from softbench.leaderboard import paper_tables
-from softbench.leaderboard import records
 from softbench.leaderboard import selection
+from softbench.leaderboard.figure_table import Table
+from softbench.records import exp1s as exp1s_records
 
 PAPER_FILE = "paper_exp1s.json"  # In this package; its "source" names the paper's table.
 PAPER_METRICS = {"position_mm": "pos (mm)", "orientation_deg": "ori (deg)"}
@@ -142,10 +141,11 @@ def loop_table(entry: Entry, loop: str) -> Table:
 def tip_table(entry: Entry) -> Table:
   """Normalised tip error (%) per configuration, task and loop, mean ± std over seeds."""
   tasks = entry.record["tasks"]
-  header = ("config", "robot", *(f"{task} {loop}" for task in tasks for loop in continual.LOOPS))
+  header = ("config", "robot",
+            *(f"{task} {loop}" for task in tasks for loop in exp1s_records.LOOPS))
   rows = tuple((str(index + 1), robot,
                 *(_figure(entry.statistic(loop, task, index, "normalised_tip_percent"))
-                  for task in tasks for loop in continual.LOOPS))
+                  for task in tasks for loop in exp1s_records.LOOPS))
                for index, robot in enumerate(entry.record["robots"]))
   return Table("normalised tip error (%): position error / robot length, mean ± std over seeds "
                "(the paper gives no numbers for it)", header, rows, label_columns=2)
@@ -157,7 +157,7 @@ def forgetting_table(entry: Entry) -> Table:
   rows = tuple((f"{stage + 1}: {robots[stage]}",
                 *("" if value is None else f"{value:.2f}" for value in row))
                for stage, row in enumerate(entry.forgetting()))
-  return Table(f"forgetting matrix: normalised tip error (%) on {continual.FORGETTING_TASK}, "
+  return Table(f"forgetting matrix: normalised tip error (%) on {exp1s_records.FORGETTING_TASK}, "
                f"closed loop, of each configuration (columns) after each training stage (rows), "
                f"mean over seeds (the paper shows it only as a figure)",
                ("after stage", *robots), rows, label_columns=1)
@@ -165,7 +165,7 @@ def forgetting_table(entry: Entry) -> Table:
 
 def score_tables(entry: Entry) -> tuple[Table, ...]:
   """The error tables of one entry: per loop, then the normalised tip error."""
-  return (*(loop_table(entry, loop) for loop in continual.LOOPS), tip_table(entry))
+  return (*(loop_table(entry, loop) for loop in exp1s_records.LOOPS), tip_table(entry))
 
 
 def tables(entry: Entry) -> tuple[Table, ...]:

@@ -46,7 +46,7 @@ def _overviews(views: tuple[overview.Overview, ...]) -> list[str]:
   lines = []
   for view in views:
     lines += [f'<a id="{view.anchor}"></a>', "", f"## {view.title}", "",
-              *_figure_table(view.table)]
+              *table_lines(view.table)]
   return lines + ([_escaped(overview.about_paper()), ""] if views else [])
 
 
@@ -72,7 +72,8 @@ def _table(group: ranking.Group, out: pathlib.Path) -> list[str]:
   return lines
 
 
-def _figure_table(table: figure_table.Table) -> list[str]:
+def table_lines(table: figure_table.Table) -> list[str]:
+  """A table of figures as this page shows it: the caption in italics, then the table."""
   return [f"*{_escaped(table.caption)}*", "",
           "| " + " | ".join(map(_escaped, table.header)) + " |",
           "|" + "|".join("---" if index < table.label_columns else "---:"
@@ -87,7 +88,7 @@ def _exp1s_group(group: exp1s_board.Group, out: pathlib.Path) -> list[str]:
               f"{_escaped(exp1s_board.describe(entry))}; record "
               f"{_link(entry.path.name, links.record(entry, out))}.", ""]
     for table in exp1s_board.tables(entry):
-      lines += _figure_table(table)
+      lines += table_lines(table)
   if group.superseded:
     lines += ["Superseded by a newer record of the same agent and profile: " +
               "; ".join(f"{_link(entry.path.name, links.record(entry, out))} "

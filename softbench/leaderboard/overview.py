@@ -15,10 +15,10 @@ import dataclasses
 from softbench import agents
 from softbench import profiles
 from softbench import suite
-from softbench.agents import learned
+from softbench.leaderboard import paper_tables
 from softbench.leaderboard import ranking
 from softbench.leaderboard.figure_table import Table
-from softbench.leaderboard import paper_tables
+from softbench.records import fields as record_fields
 
 PAPER_FILE = "paper_exp2.json"  # In this package; its "source" names the paper's tables.
 METRIC = "position_mm"
@@ -94,7 +94,7 @@ def overviews(board: ranking.Leaderboard) -> tuple[Overview, ...]:
                            Table(caption, ("agent", *tasks), rows, label_columns=1)))
   return tuple(sorted(tables, key=lambda view: (
       ranking.robot_order(view.robot), _known_first(view.profile, profiles.PROFILES),
-      _known_first(view.eval_mode, learned.ERROR_SOURCES))))
+      _known_first(view.eval_mode, record_fields.ERROR_SOURCES))))
 
 
 def about_paper() -> str:

@@ -19,10 +19,10 @@ import re
 
 import numpy as np
 
+from softbench import records
 from softbench import suite
 from softbench.leaderboard import exp1s_board
 from softbench.leaderboard import selection
-from softbench.leaderboard import records
 
 CONFIDENCE = 0.95
 BOOTSTRAP_RESAMPLES = 10_000

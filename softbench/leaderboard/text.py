@@ -3,11 +3,11 @@ robot and task, then the Exp1S sections."""
 
 import pathlib
 
+from softbench import records
 from softbench.leaderboard import exp1s_board
 from softbench.leaderboard import figure_table
 from softbench.leaderboard import overview
 from softbench.leaderboard import ranking
-from softbench.leaderboard import records
 
 _COLUMN_GAP = "  "
 

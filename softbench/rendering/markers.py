@@ -14,7 +14,7 @@ import mujoco
 import numpy as np
 from dm_control.mujoco import engine
 
-from softbench import evaluation
+from softbench import episodes
 from softbench import metrics
 
 MAX_TRAIL_MARKERS = 400  # Per module.
@@ -93,7 +93,7 @@ class EpisodeMarkers:
   """The decorations of one episode; ``at(time, tips)`` moves them to a moment, then the object
   is a dm_control ``scene_callback`` that adds them to the scene."""
 
-  def __init__(self, episode: evaluation.Episode, colours: np.ndarray, robot_length: float,
+  def __init__(self, episode: episodes.Episode, colours: np.ndarray, robot_length: float,
                arm_radius: float, title: str):
     """``colours``: (num_modules, 4) every module's colour; ``robot_length`` and ``arm_radius``
     (m) scale the markers; ``title``: the caption's first line."""

@@ -11,8 +11,7 @@ from typing import Iterator
 
 import numpy as np
 
-from softbench import evaluation
-from softbench import robots
+from softbench import episodes
 from softbench import suite
 from softbench.robots import base
 from softbench.robots import physics as arm_physics
@@ -37,7 +36,7 @@ class Replay:
   task: str
   seed: int
   task_options: dict
-  episode: evaluation.Episode
+  episode: episodes.Episode
   title: str
 
   @property
@@ -78,13 +77,3 @@ def moments(replay: Replay,
       physics.step(int(bounds[piece + 1] - bounds[piece]))
       yield step + (piece + 1) / frames_per_step, physics
     _check(physics, replay.episode.poses[step + 1], step + 1)
-
-
-def of_run(run, seed: int, episode: evaluation.Episode) -> Replay:
-  """The replay of ``episode``, seed ``seed`` of ``run`` (``softbench.run.RunSettings``)."""
-  # Imported here: the rendering worker replays without the training stack ``run`` loads.
-  from softbench import run as run_module  # pylint: disable=import-outside-toplevel
-  feedback = "" if run.eval_mode == "physics" else f", eval {run.eval_mode}"
-  return Replay(robots.make(run.robot), run.task, seed, run_module.task_options(run), episode,
-                f"{run.agent} on {run.task} ({run.robot}) seed {seed}, {run.profile.name} "
-                f"profile{feedback}")

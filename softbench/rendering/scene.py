@@ -8,10 +8,10 @@ a frame is drawn by copying the simulated state in (``show_state``).
 import mujoco
 import numpy as np
 
-from softbench import evaluation
+from softbench import episodes
+from softbench.rendering import options
 from softbench.robots import base
 from softbench.robots import chain
-from softbench.rendering import options
 
 FOVY_DEG = 45.0  # (deg) Vertical field of view of every camera (MuJoCo's default).
 FRAME_MARGIN = 1.2  # Framed half-extent over the episode's half-extent.
@@ -36,7 +36,7 @@ def module_colours(model: mujoco.MjModel, num_modules: int) -> np.ndarray:
                    for k in range(1, num_modules + 1)])
 
 
-def episode_points(episode: evaluation.Episode) -> np.ndarray:
+def episode_points(episode: episodes.Episode) -> np.ndarray:
   """(n, 3) every point of ``episode`` a frame shows: each module's tip at every step and every
   target position (m)."""
   return np.concatenate([episode.poses[..., :3].reshape(-1, 3),

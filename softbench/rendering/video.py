@@ -17,8 +17,9 @@ import tempfile
 import time
 
 import numpy as np
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.progress import Progress
 
+from softbench import progress as progress_bars
 from softbench.rendering import options as video_options
 from softbench.rendering import replay as episode_replay
 from softbench.rendering import worker
@@ -131,8 +132,7 @@ def render(replay: episode_replay.Replay, output: str | os.PathLike,
     video_options.check_video_path(output)
   request = {"replay": replay, "options": options, "output": str(output.absolute())}
   failures = {}
-  progress = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                      TimeElapsedColumn(), disable=not show_progress, transient=True)
+  progress = progress_bars.counting(show_progress, transient=True)
   with progress:
     for backend in backend_candidates():
       bar = progress.add_task(f"rendering {output.name} ({backend})",

@@ -5,6 +5,7 @@
 """
 
 import dataclasses
+import re
 
 from softbench.robots.base import SoftArm
 from softbench.robots.pneumatic import PneumaticArm
@@ -14,18 +15,71 @@ from softbench.robots.tendon_local import LocalTendonArm
 TENDON_FAMILIES = {family.FAMILY: family for family in (TendonArm, LocalTendonArm)}
 """Tendon arm families by name: ``tendon`` routes distal cables through the proximal modules,
 ``tendon-local`` keeps every cable within its module (the paper's simulator)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Family:
+  """Robots that share a builder: ``name-N`` for N modules (``numbered``), or ``name`` alone.
+
+  Attributes:
+    name: The family's name, and the prefix of its robots' names.
+    arm: The arm class; numbered families build through ``arm.from_name(name)``.
+    numbered: Whether names carry a number of modules.
+    benchmark: The family's robots that the benchmark (``softbench robots``) lists.
+  """
+
+  name: str
+  arm: type[SoftArm]
+  numbered: bool
+  benchmark: tuple[str, ...]
+
+  def __post_init__(self):
+    if not re.fullmatch(r"[a-z0-9]+(-[a-z0-9]+)*", self.name):
+      raise ValueError(f"family names are lowercase words joined by hyphens, got {self.name!r}")
+
+  @property
+  def usage(self) -> str:
+    return f"{self.name}-N" if self.numbered else self.name
+
+  @property
+  def pattern(self) -> str:
+    """A regular expression of the names the family answers (as records hold them)."""
+    return f"{self.name}-[1-9][0-9]*" if self.numbered else self.name
+
+  def answers(self, name: str) -> bool:
+    return name.startswith(f"{self.name}-") if self.numbered else name == self.name
+
+  def build(self, name: str, overrides: dict) -> SoftArm:
+    if self.numbered:
+      return self.arm.from_name(name, **_checked(self.arm, overrides))
+    return self.arm(**_checked(self.arm, overrides))
+
+
 BENCHMARK_MODULES = range(1, 6)  # N of the benchmark tendon arms, tendon-1 .. tendon-5.
-BENCHMARK_ROBOTS = (*(f"{family}-{n}" for family in TENDON_FAMILIES for n in BENCHMARK_MODULES),
-                    "pneumatic-433")
+FAMILIES = (
+    *(Family(name, arm, True, tuple(f"{name}-{n}" for n in BENCHMARK_MODULES))
+      for name, arm in TENDON_FAMILIES.items()),
+    Family("pneumatic-433", PneumaticArm, False, ("pneumatic-433",)),
+)
+"""Every robot family; a new one is an arm class and one entry here. A name belongs to the
+longest family name it starts with (``tendon-local-x`` is a malformed ``tendon-local`` name)."""
+BENCHMARK_ROBOTS = tuple(robot for family in FAMILIES for robot in family.benchmark)
+NAME_PATTERN = f"^({'|'.join(family.pattern for family in FAMILIES)})$"
+"""Every robot name any family answers, as a regular expression (for the records' schema)."""
+
+
+def family_of(name: str) -> Family | None:
+  """The family that answers ``name`` (its longest name first), or None."""
+  for family in sorted(FAMILIES, key=lambda family: len(family.name), reverse=True):
+    if family.answers(name):
+      return family
+  return None
 
 
 def tendon_family(name: str) -> type[CableDrivenArm] | None:
-  """The tendon family whose names ``name`` has the form of (``tendon-local-x`` is a malformed
-  ``tendon-local`` name, not a ``tendon`` one), or None."""
-  for family in sorted(TENDON_FAMILIES, key=len, reverse=True):
-    if name.startswith(f"{family}-"):
-      return TENDON_FAMILIES[family]
-  return None
+  """The tendon arm class whose names ``name`` has the form of, or None."""
+  family = family_of(name)
+  return family.arm if family is not None and family.name in TENDON_FAMILIES else None
 
 
 def make(name: str, **overrides) -> SoftArm:
@@ -36,12 +90,11 @@ def make(name: str, **overrides) -> SoftArm:
   """
   if not isinstance(name, str):
     raise ValueError(f"robot name must be a string, got {name!r}")
-  if family := tendon_family(name):
-    return family.from_name(name, **_checked(family, overrides))
-  if name == "pneumatic-433":
-    return PneumaticArm(**_checked(PneumaticArm, overrides))
-  raise ValueError(f"unknown robot {name!r}; choose tendon-N or tendon-local-N (N = 1 to "
-                   f"{MAX_MODULES}) or pneumatic-433")
+  if family := family_of(name):
+    return family.build(name, overrides)
+  raise ValueError(f"unknown robot {name!r}; choose "
+                   f"{' or '.join(family.usage for family in FAMILIES)} (N = 1 to "
+                   f"{MAX_MODULES})")
 
 
 def _checked(family: type, overrides: dict) -> dict:
@@ -52,5 +105,6 @@ def _checked(family: type, overrides: dict) -> dict:
   return overrides
 
 
-__all__ = ["BENCHMARK_ROBOTS", "MAX_MODULES", "TENDON_FAMILIES", "CableDrivenArm",
-           "LocalTendonArm", "PneumaticArm", "SoftArm", "TendonArm", "make", "tendon_family"]
+__all__ = ["BENCHMARK_ROBOTS", "FAMILIES", "MAX_MODULES", "NAME_PATTERN", "TENDON_FAMILIES",
+           "CableDrivenArm", "Family", "LocalTendonArm", "PneumaticArm", "SoftArm", "TendonArm",
+           "family_of", "make", "tendon_family"]

@@ -70,10 +70,35 @@ _TASKS = {
                         "tendon-3", None),
 }
 TASKS = tuple(_TASKS)
-ALL_TASKS = tuple((robot, task) for robot in robots.BENCHMARK_ROBOTS for task in TASKS
-                  if "user" not in _TASKS[task].tags)
-BENCHMARKING = tuple((robot, task) for robot, task in ALL_TASKS
-                     if "benchmarking" in _TASKS[task].tags)
+
+
+def _pairs() -> tuple[tuple[tuple[str, str], ...], tuple[tuple[str, str], ...]]:
+  """Every (robot, task) pair of the benchmark robots and the tasks that need no user input, and
+  those of them tagged ``benchmarking``."""
+  every = tuple((robot, task) for robot in robots.BENCHMARK_ROBOTS for task in TASKS
+                if "user" not in _TASKS[task].tags)
+  return every, tuple(pair for pair in every if "benchmarking" in _TASKS[pair[1]].tags)
+
+
+ALL_TASKS, BENCHMARKING = _pairs()
+
+
+def register(name: str, entry: TaskEntry) -> None:
+  """Adds task ``name`` to the suite (``TASKS``, ``ALL_TASKS`` and ``BENCHMARKING`` are rebound
+  to include it): ``entry.build(robot, random=..., **options)`` returns a ``SoftArmTask``.
+
+  Raises:
+    ValueError: the name is taken or malformed, or the paper robot is unknown (one line).
+  """
+  global TASKS, ALL_TASKS, BENCHMARKING
+  if not isinstance(name, str) or not name or name != name.strip().lower() or " " in name:
+    raise ValueError(f"task names are lowercase words without spaces, got {name!r}")
+  if name in _TASKS:
+    raise ValueError(f"task {name!r} is registered already")
+  robots.make(entry.paper_robot)
+  _TASKS[name] = entry
+  TASKS = tuple(_TASKS)
+  ALL_TASKS, BENCHMARKING = _pairs()
 
 
 def describe(task: str) -> TaskEntry:
@@ -126,4 +151,5 @@ def load(robot: str | robots.SoftArm, task: str, seed=None, environment_kwargs: 
                              **(environment_kwargs or {}))
 
 
-__all__ = ["ALL_TASKS", "BENCHMARKING", "TASKS", "describe", "length_options", "load"]
+__all__ = ["ALL_TASKS", "BENCHMARKING", "TASKS", "TaskEntry", "describe", "length_options", "load",
+           "register"]

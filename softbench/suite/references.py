@@ -22,6 +22,7 @@ import functools
 import hashlib
 import json
 import os
+from collections.abc import Callable
 
 import numpy as np
 
@@ -41,7 +42,6 @@ SPIRAL_TURNS = 5
 LEAD_IN = 0.05  # Fraction of the steps over which circle and rectangle grow from the centre.
 AMPLITUDE_GRID = np.linspace(0.05, 1.0, 20)  # Actuations tried when calibrating the amplitude.
 SETTLE_SECONDS = 3.0  # (s) Hold per calibration actuation; longer than any settling time.
-SHAPES = ("babbling", "circle", "rectangle", "spiral")
 FORMAT_VERSION = 1
 
 
@@ -84,24 +84,55 @@ def bend_amplitude(robot: base.SoftArm) -> float:
   return float(np.interp(BEND_DEG, bends[first - 1:first + 1], AMPLITUDE_GRID[first - 1:first + 1]))
 
 
+def _lead_in(length: int) -> np.ndarray:
+  """(length, 1) factors that grow a path from the centre over its first ``LEAD_IN`` steps."""
+  return np.minimum(1.0, np.arange(1, length + 1) / (LEAD_IN * length))[:, None]
+
+
+def _circle(length: int) -> np.ndarray:
+  return _lead_in(length) * _on_circle(CIRCLE_RADIUS, _phases(length, CIRCLE_TURNS))
+
+
+def _rectangle(length: int) -> np.ndarray:
+  return _lead_in(length) * _on_rectangle(_phases(length, RECTANGLE_LAPS))
+
+
+def _spiral(length: int) -> np.ndarray:
+  return _on_circle(_phases(length, 1.0), _phases(length, SPIRAL_TURNS))
+
+
+def _planar(path: Callable[[int], np.ndarray]) -> Callable[..., np.ndarray]:
+  """The actions of a path (length, 2) in the planar actuation space, in bend amplitudes."""
+  def actions(robot: base.SoftArm, length: int, amplitude: float | None) -> np.ndarray:
+    amplitude = bend_amplitude(robot) if amplitude is None else amplitude
+    return robot.planar_action(amplitude * path(length))
+  return actions
+
+
+def _babbling(robot: base.SoftArm, length: int, amplitude: float | None) -> np.ndarray:
+  del amplitude  # Uniform over the whole action range.
+  stream = seeding.rng(0, seeding.HELD_OUT_BABBLING_STREAM)
+  return stream.uniform(-1.0, 1.0, (length, robot.action_dim))
+
+
+_GENERATORS = {"babbling": _babbling, "circle": _planar(_circle),
+               "rectangle": _planar(_rectangle), "spiral": _planar(_spiral)}
+"""Shape name -> ``generate(robot, length, amplitude) -> actions (length, action_dim)``; a new
+shape is a generator and one entry here."""
+SHAPES = tuple(_GENERATORS)
+
+
+def _check_shape(shape: str) -> None:
+  if shape not in _GENERATORS:
+    raise ValueError(f"unknown reference shape {shape!r}; choose one of {', '.join(SHAPES)}")
+
+
 def pattern_actions(robot: base.SoftArm, shape: str, length: int = REFERENCE_LENGTH,
                     amplitude: float | None = None) -> np.ndarray:
   """The generating actions (length, action_dim) of reference ``shape``; ``amplitude`` is
   ``bend_amplitude(robot)`` unless given."""
-  if shape not in SHAPES:
-    raise ValueError(f"unknown reference shape {shape!r}; choose one of {', '.join(SHAPES)}")
-  if shape == "babbling":
-    stream = seeding.rng(0, seeding.HELD_OUT_BABBLING_STREAM)
-    return stream.uniform(-1.0, 1.0, (length, robot.action_dim))
-  amplitude = bend_amplitude(robot) if amplitude is None else amplitude
-  lead_in = np.minimum(1.0, np.arange(1, length + 1) / (LEAD_IN * length))[:, None]
-  if shape == "circle":
-    points = lead_in * _on_circle(CIRCLE_RADIUS, _phases(length, CIRCLE_TURNS))
-  elif shape == "rectangle":
-    points = lead_in * _on_rectangle(_phases(length, RECTANGLE_LAPS))
-  else:
-    points = _on_circle(_phases(length, 1.0), _phases(length, SPIRAL_TURNS))
-  return robot.planar_action(amplitude * points)
+  _check_shape(shape)
+  return _GENERATORS[shape](robot, length, amplitude)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -154,8 +185,7 @@ def reference(robot: base.SoftArm, shape: str, length: int = REFERENCE_LENGTH) -
   """The reference ``shape`` of ``robot``, from the cache or simulated (and then cached)."""
   if not (isinstance(length, int) and length >= 1):
     raise ValueError(f"reference length must be a positive integer, got {length!r}")
-  if shape not in SHAPES:
-    raise ValueError(f"unknown reference shape {shape!r}; choose one of {', '.join(SHAPES)}")
+  _check_shape(shape)
   config = _config(robot, shape, length)
   key = hashlib.sha256(json.dumps(config, sort_keys=True).encode()).hexdigest()[:12]
   path = storage.softbench_home() / "references" / f"{robot.name}-{shape}-n{length}-{key}.npz"

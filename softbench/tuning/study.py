@@ -23,27 +23,23 @@ trains the previous and the best values again at the profile's full budget, as t
 import dataclasses
 import datetime
 import hashlib
-import importlib
 import json
 import math
 import pathlib
 
 import optuna
-from rich.progress import BarColumn
-from rich.progress import MofNCompleteColumn
-from rich.progress import Progress
 from rich.progress import TextColumn
-from rich.progress import TimeElapsedColumn
 
 import softbench
 from softbench import agents
 from softbench import profiles
+from softbench import progress as progress_bars
 from softbench import robots
 from softbench import storage
 from softbench.agents import hyperparameters
 from softbench.agents import learned
 
-DEFAULT_TRIALS = 10  # Trials per study, the same for every agent (README: budget).
+DEFAULT_TRIALS = 10  # Trials per study, the same for every agent (docs/tuning.md: budget).
 DATABASE = "tuning.db"  # Default SQLite storage, under the data home.
 SUMMARY_FOLDER = "tuning"  # Study summaries, under the data home.
 _TPE_STARTUP_TRIALS = 4  # Trials sampled at random (the previous values among them) before TPE.
@@ -125,9 +121,9 @@ def settings(agent: str, robot: str, trials: int = DEFAULT_TRIALS, storage_url: 
   return TuneSettings(agent, robot, trials, chosen_profile, storage_url, name, epochs)
 
 
-def learner(agent: str) -> learned.Learner:
+def learner(agent: str) -> agents.Learner:
   """How ``agent`` (a learned agent of the registry) makes its inverse model."""
-  return importlib.import_module(agents.describe(agent).module).LEARNER
+  return agents.learner(agent)
 
 
 def run(settings: TuneSettings, show_progress: bool = True) -> dict:
@@ -324,9 +320,7 @@ class _TrialProgress:
   """A progress bar over the study's finished trials, with the best value so far."""
 
   def __init__(self, settings: TuneSettings, study: optuna.Study, show: bool) -> None:
-    self._progress = Progress(TextColumn("{task.description}"), BarColumn(),
-                              MofNCompleteColumn(), TextColumn("{task.fields[best]}"),
-                              TimeElapsedColumn(), disable=not show)
+    self._progress = progress_bars.counting(show, extra=(TextColumn("{task.fields[best]}"),))
     self._task = self._progress.add_task(f"tune {settings.agent} {settings.robot}",
                                          total=settings.trials, best="")
     self.update(study)

@@ -17,7 +17,9 @@ model is trained instead. Everything else (checking the configuration, the weigh
 the cache's usual loading.
 
 The zoo is ``$SOFTBENCH_ZOO`` if set (``none`` turns it off), else the ``zoo/`` folder of the
-source checkout softbench runs from.
+source checkout softbench runs from. Which records each file stands behind, and re-scoring them
+from the zoo alone, belong to the leaderboard (``leaderboard.zoo_catalogue``,
+``leaderboard.zoo_verification``).
 """
 
 import dataclasses

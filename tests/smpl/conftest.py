@@ -19,10 +19,11 @@ from smpl.training import (
     limited_cpu_threads,
     train_forward_model,
 )
-from smpl.windows import BabblingWindows
+from smpl.windows import SEQUENCE_LENGTH, BabblingWindows
 
 POSE_SIZE = 6
 LAG = 0.5
+SHORT_WINDOW = 2  # Control steps per window of the compile tests' data.
 """Fraction of the previous pose the synthetic arm keeps each step (first-order lag)."""
 
 
@@ -34,7 +35,8 @@ def _few_cpu_threads() -> Iterator[None]:
 
 
 def synthetic_windows(
-    recording_steps: int, action_size: int, seed: int, arm_seed: int = 0
+    recording_steps: int, action_size: int, seed: int, arm_seed: int = 0,
+    window_length: int = SEQUENCE_LENGTH,
 ) -> BabblingWindows:
     """Windows of random babbling on an arm with x_{s+1} = LAG x_s + (1 - LAG) tanh(a_s M).
 
@@ -48,7 +50,7 @@ def synthetic_windows(
     for step in range(1, recording_steps):
         steady_pose = torch.tanh(actions[step - 1] @ mixing)
         poses[step] = LAG * poses[step - 1] + (1 - LAG) * steady_pose
-    return BabblingWindows.from_recording(poses, actions)
+    return BabblingWindows.from_recording(poses, actions, window_length=window_length)
 
 
 @pytest.fixture(scope="session")
@@ -63,6 +65,16 @@ def arm_data() -> dict[str, BabblingWindows]:
     return {
         "train": synthetic_windows(400, action_size=2, seed=1),
         "validation": synthetic_windows(150, action_size=2, seed=2),
+    }
+
+
+@pytest.fixture(scope="session")
+def short_arm_data() -> dict[str, BabblingWindows]:
+    """`arm_data`'s recordings cut into windows of `SHORT_WINDOW` steps: a closed-loop training
+    step unrolls its window, so compiling it takes a fraction of the time of full windows."""
+    return {
+        "train": synthetic_windows(400, action_size=2, seed=1, window_length=SHORT_WINDOW),
+        "validation": synthetic_windows(150, action_size=2, seed=2, window_length=SHORT_WINDOW),
     }
 
 

@@ -10,10 +10,14 @@ from collections.abc import Callable
 from typing import NoReturn
 
 from softbench import profiles
+from softbench import robots
 
 INTEGRITY_FIELD = "sha256"
+ERROR_SOURCES = ("physics", "model", "open-loop")
+"""What a learned controller's error input is computed from (a record's ``eval_mode``): the
+measured pose, the learned forward model's prediction, or nothing (``softbench.agents.learned``)."""
 AGENT_PATTERN = r"^[a-z0-9][a-z0-9_.-]*$"
-ROBOT_PATTERN = r"^(tendon-[1-9][0-9]*|tendon-local-[1-9][0-9]*|pneumatic-433)$"
+ROBOT_PATTERN = robots.NAME_PATTERN
 MAX_ERROR = 1e6
 """Bound on every error in a record (mm, deg, %, pose MSE). The arms are at most 0.5 m long, so
 real errors stay below a few thousand; the bound refuses absurd values (1e308 would overflow the

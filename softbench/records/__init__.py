@@ -30,9 +30,8 @@ from jsonschema import exceptions as schema_exceptions
 from softbench import robots
 from softbench import storage
 from softbench import suite
-from softbench.agents import learned
-from softbench.leaderboard import exp1s_records
-from softbench.leaderboard import record_fields
+from softbench.records import exp1s as exp1s_records
+from softbench.records import fields as record_fields
 
 DEFAULT_FOLDER = pathlib.Path("leaderboard/results")  # Where softbench run writes records.
 FORMAT = "softbench-result"
@@ -75,7 +74,7 @@ def schema() -> dict:
       "version": {"const": VERSION},
       "robot": {"type": "string", "pattern": record_fields.ROBOT_PATTERN},
       "task": {"enum": list(suite.TASKS)},
-      "eval_mode": {"enum": list(learned.ERROR_SOURCES)},
+      "eval_mode": {"enum": list(record_fields.ERROR_SOURCES)},
       "trajectory": {"type": ["string", "null"]},
       "scored_modules": {"type": "array", "items": {"type": "integer", "minimum": 1},
                          "minItems": 1, "uniqueItems": True},

@@ -12,11 +12,11 @@ from collections.abc import Iterator
 
 from softbench import continual
 from softbench import profiles
+from softbench import records
 from softbench import robots
 from softbench import run as run_module
 from softbench import storage
 from softbench import zoo
-from softbench.leaderboard import records
 
 
 @dataclasses.dataclass(frozen=True)

@@ -7,9 +7,9 @@ import pathlib
 from softbench import agents
 from softbench import continual
 from softbench import profiles
+from softbench import records
 from softbench import robots
 from softbench.agents import learned
-from softbench.leaderboard import records
 
 
 @dataclasses.dataclass(frozen=True)

@@ -11,13 +11,17 @@ integrity hash) is refused. The layout is ``softbench.continual``'s, which write
 
 import math
 
-from softbench import continual
 from softbench import metrics
 from softbench import robots
-from softbench.leaderboard import record_fields
+from softbench.records import fields as record_fields
 
-FORMAT = continual.RECORD_FORMAT
-VERSION = continual.RECORD_VERSION
+FORMAT = "softbench-exp1s-result"
+VERSION = 2  # 2: sealed with an integrity hash.
+PROTOCOL = "exp1s"
+TASKS = ("babbling", "circle", "rectangle", "spiral")  # The paper's Exp1S table.
+LOOPS = {"closed": "physics", "open": "open-loop"}  # Table label -> the agent's error source.
+FORGETTING_TASK = "spiral"
+METRICS = ("position_mm", "orientation_deg", "normalised_tip_percent")
 MATRICES = ("forgetting_model_pose_mse", "forgetting_tip_percent")
 _TIP_TOLERANCE = 1e-9  # Relative: normalised tip error against position error / robot length.
 
@@ -26,9 +30,9 @@ def schema() -> dict:
   """The JSON Schema (draft 2020-12) of an Exp1S record."""
   non_negative = record_fields.non_negative()
   configuration = {"type": "object", "additionalProperties": False,
-                   "required": list(continual.METRICS),
-                   "properties": {name: non_negative for name in continual.METRICS}}
-  per_task = {"type": "object", "propertyNames": {"enum": list(continual.TASKS)},
+                   "required": list(METRICS),
+                   "properties": {name: non_negative for name in METRICS}}
+  per_task = {"type": "object", "propertyNames": {"enum": list(TASKS)},
               "additionalProperties": {"type": "array", "items": configuration, "minItems": 1}}
   matrix = {"type": "array", "minItems": 1,
             "items": {"type": "array", "items": {"anyOf": [non_negative, {"type": "null"}]}}}
@@ -37,19 +41,19 @@ def schema() -> dict:
       "required": ["seed", "scores", *MATRICES],
       "properties": {"seed": {"type": "integer", "minimum": 0},
                      "scores": {"type": "object", "additionalProperties": False,
-                                "required": list(continual.LOOPS),
-                                "properties": {loop: per_task for loop in continual.LOOPS}},
+                                "required": list(LOOPS),
+                                "properties": {loop: per_task for loop in LOOPS}},
                      **{name: matrix for name in MATRICES}},
       "additionalProperties": record_fields.section(),
   }
   properties = {
       "format": {"const": FORMAT},
       "version": {"const": VERSION},
-      "protocol": {"const": continual.PROTOCOL},
+      "protocol": {"const": PROTOCOL},
       "robots": {"type": "array", "minItems": 1, "uniqueItems": True,
                  "items": {"type": "string", "pattern": record_fields.ROBOT_PATTERN}},
       "tasks": {"type": "array", "minItems": 1, "uniqueItems": True,
-                "items": {"enum": list(continual.TASKS)}},
+                "items": {"enum": list(TASKS)}},
       "per_seed": {"type": "array", "items": seed, "minItems": 1},
       **record_fields.properties(),
   }
@@ -73,19 +77,19 @@ def check(record: dict, refuse: record_fields.Refuse) -> None:
       lengths_mm[name] = robots.make(name).length * metrics.MM_PER_M
     except ValueError as error:
       refuse(f"robots: {error}")
-  if continual.FORGETTING_TASK not in record["tasks"]:
-    refuse(f"tasks {record['tasks']} lack {continual.FORGETTING_TASK}, the task of the "
+  if FORGETTING_TASK not in record["tasks"]:
+    refuse(f"tasks {record['tasks']} lack {FORGETTING_TASK}, the task of the "
            f"forgetting matrix")
   for index, entry in enumerate(record["per_seed"]):
     _check_scores(record, entry["scores"], f"per_seed[{index}].scores", lengths_mm, refuse)
     for name in MATRICES:
       _check_triangular(entry[name], len(record["robots"]), f"per_seed[{index}].{name}", refuse)
     closed = [scores["normalised_tip_percent"]
-              for scores in entry["scores"]["closed"][continual.FORGETTING_TASK]]
+              for scores in entry["scores"]["closed"][FORGETTING_TASK]]
     if entry["forgetting_tip_percent"][-1] != closed:
       refuse(f"per_seed[{index}].forgetting_tip_percent's last row "
              f"{entry['forgetting_tip_percent'][-1]} is not the closed-loop "
-             f"{continual.FORGETTING_TASK} normalised tip errors {closed}")
+             f"{FORGETTING_TASK} normalised tip errors {closed}")
 
 
 def _check_scores(record: dict, scores: dict, where: str, lengths_mm: dict,

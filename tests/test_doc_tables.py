@@ -1,0 +1,139 @@
+"""The results tables of README.md and docs/*.md are generated from the committed records
+(``softbench.leaderboard.doc_tables``): every block is known and up to date, no typed table of
+scores hides outside a block, and ``softbench leaderboard --write`` rewrites the blocks."""
+
+import pathlib
+import re
+import shutil
+
+import pytest
+
+from softbench import cli
+from softbench import leaderboard
+from softbench.leaderboard import doc_tables
+
+ROOT = pathlib.Path(__file__).parent.parent
+RESULTS = ROOT / "leaderboard" / "results"
+# Tables of one-off measurements that no record holds (each page names the script or commit).
+ONE_OFF_TABLE_HEADERS = (
+    "| helpers |",  # docs/paper-comparison.md: reach with the other helper convention.
+    "| robot, fault |",  # docs/faults.md: records of the fault experiment, in docs/faults/.
+    "| stage |",  # docs/adaptive-activation.md: adaptive activation per stage.
+)
+EXP1S_RECORD = "smpl-exp1s-default-2026-11-24T041101Z.json"
+
+
+@pytest.fixture(scope="module")
+def board():
+  return leaderboard.build(RESULTS)
+
+
+@pytest.fixture(scope="module")
+def pages() -> dict[pathlib.Path, str]:
+  return {page: page.read_text(encoding="utf-8") for page in doc_tables.pages(RESULTS)}
+
+
+def _block(name: str, body: str = "") -> str:
+  return f"<!-- softbench:table {name} -->\n{body}<!-- /softbench:table -->\n"
+
+
+def test_the_pages_are_the_readme_and_the_docs(pages):
+  assert ROOT / "README.md" in pages
+  assert ROOT / "docs" / "paper-comparison.md" in pages
+  assert sum(len(doc_tables.blocks(text)) for text in pages.values()) >= len(doc_tables.TABLES)
+
+
+def test_every_block_is_known_and_equals_what_the_records_give(pages, board):
+  for page, text in pages.items():
+    assert doc_tables.stale_blocks(text, board, str(page)) == [], (
+        f"{page}: out of date; run softbench leaderboard --write")
+
+
+def test_every_named_table_appears_in_the_docs(pages):
+  shown = {block.name for text in pages.values() for block in doc_tables.blocks(text)}
+  assert shown == set(doc_tables.TABLES)
+
+
+def test_no_typed_table_of_scores_outside_the_blocks(pages):
+  for page, text in pages.items():
+    lines = text.split("\n")
+    inside = {line for block in doc_tables.blocks(text) for line in range(block.start, block.end)}
+    header = None
+    for number, line in enumerate(lines):
+      if not line.lstrip().startswith("|"):
+        header = None
+        continue
+      header = header or line.strip()
+      if number not in inside and " ± " in line:
+        assert header.startswith(ONE_OFF_TABLE_HEADERS), (
+            f"{page}:{number + 1}: a typed table of scores; generate it (doc_tables.TABLES)")
+
+
+def test_an_unknown_table_fails(board):
+  with pytest.raises(doc_tables.DocTableError, match=r"README.md:2: unknown table 'no-such'"):
+    doc_tables.blocks("text\n" + _block("no-such"), "README.md")
+  with pytest.raises(doc_tables.DocTableError, match="unknown table"):
+    doc_tables.render("no-such", board)
+
+
+@pytest.mark.parametrize("text,message", [
+    (_block("headline-spiral").removesuffix("<!-- /softbench:table -->\n"), "never closed"),
+    ("<!-- /softbench:table -->\n", "without an opening marker"),
+    (_block("headline-spiral", "<!-- softbench:table headline-spiral -->\n"), "inside block"),
+])
+def test_a_malformed_block_fails(text, message):
+  with pytest.raises(doc_tables.DocTableError, match=message):
+    doc_tables.blocks(text)
+
+
+def test_an_out_of_date_block_fails_and_rewriting_mends_it(pages, board):
+  readme = pages[ROOT / "README.md"]
+  generated = doc_tables.render("headline-spiral", board)
+  edited = readme.replace(generated, generated.replace("6.69 ± 1.77", "6.68 ± 1.77"), 1)
+  assert edited != readme
+  assert doc_tables.stale_blocks(edited, board) == ["headline-spiral"]
+  assert doc_tables.rewrite(edited, board) == readme
+  emptied = readme.replace(generated, "", 1)
+  assert doc_tables.stale_blocks(emptied, board) == ["headline-spiral"]
+  assert doc_tables.rewrite(emptied, board) == readme
+
+
+def test_the_tables_use_the_records_population_std(board):
+  # pneumatic-433 SMPL, paper profile, spiral: std over the 5 seeds with ddof 0 is 0.30 (ddof 1:
+  # 0.34, which a typed table once showed).
+  smpl = ("| smpl | 11.48 ± 0.31 (4.97) | 2.81 ± 0.35 (2.77) | 2.91 ± 0.34 (2.38) | "
+          "2.58 ± 0.30 (3.02) |")
+  assert smpl in doc_tables.render("overview-pneumatic-433-paper", board)
+
+
+def test_leaderboard_write_rewrites_the_blocks_of_the_checkout(tmp_path, capsys):
+  results = tmp_path / "leaderboard" / "results"
+  results.mkdir(parents=True)
+  shutil.copy(RESULTS / EXP1S_RECORD, results)
+  (tmp_path / "docs").mkdir()
+  stale = "# Exp1S\n\n" + _block("exp1s-tendon-default", "| typed | 1.00 ± 0.10 |\n") + "\nEnd.\n"
+  untouched = "# No tables\n"
+  for path, text in ((tmp_path / "README.md", stale), (tmp_path / "docs" / "exp1s.md", stale),
+                     (tmp_path / "docs" / "other.md", untouched)):
+    path.write_text(text)
+  cli.main(["leaderboard", "--results", str(results), "--write", "--out",
+            str(tmp_path / "leaderboard")])
+  board = leaderboard.build(results)
+  expected = doc_tables.rewrite(stale, board)
+  assert "20.00 ± 5.24 (1.49)" in expected and "typed" not in expected
+  assert (tmp_path / "README.md").read_text() == expected
+  assert (tmp_path / "docs" / "exp1s.md").read_text() == expected
+  assert (tmp_path / "docs" / "other.md").read_text() == untouched
+  printed = capsys.readouterr().out
+  assert f"wrote {tmp_path / 'README.md'}" in printed
+  assert f"wrote {tmp_path / 'docs' / 'other.md'}" not in printed
+  # Up to date: nothing is written again.
+  cli.main(["leaderboard", "--results", str(results), "--write", "--out",
+            str(tmp_path / "leaderboard")])
+  assert "README.md" not in capsys.readouterr().out.replace("leaderboard/README.md", "")
+
+
+def test_another_results_folder_has_no_doc_pages(tmp_path):
+  (tmp_path / "README.md").write_text(_block("no-such"))
+  assert doc_tables.pages(tmp_path / "results") == []
+  assert doc_tables.pages(tmp_path / "leaderboard" / "results") == [tmp_path / "README.md"]

@@ -1,0 +1,109 @@
+"""The package's layers import one way: no cycle among softbench's units (its subpackages and
+top-level modules), counting every import statement, deferred ones too; and the agent registry,
+the records and the leaderboard import without torch."""
+
+import ast
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+import softbench
+
+PACKAGE = pathlib.Path(softbench.__file__).parent
+
+
+def _unit(module: str) -> str | None:
+  """The softbench unit (``run``, ``leaderboard``, ...) that ``module`` belongs to, or None."""
+  parts = module.split(".")
+  if parts[0] != "softbench" or len(parts) < 2:
+    return None
+  exists = (PACKAGE / parts[1]).is_dir() or (PACKAGE / f"{parts[1]}.py").is_file()
+  return parts[1] if exists else None
+
+
+def _imported(path: pathlib.Path, module: str) -> set[str]:
+  """Every module named by an import statement of ``path`` (module ``module``), relative ones
+  resolved; ``from a import b`` names both ``a`` and ``a.b``."""
+  package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+  names = set()
+  for node in ast.walk(ast.parse(path.read_text(), str(path))):
+    if isinstance(node, ast.Import):
+      names.update(alias.name for alias in node.names)
+    elif isinstance(node, ast.ImportFrom):
+      base = node.module or ""
+      if node.level:
+        anchor = package.split(".")[:len(package.split(".")) - node.level + 1]
+        base = ".".join(anchor + ([node.module] if node.module else []))
+      names.add(base)
+      names.update(f"{base}.{alias.name}" for alias in node.names)
+  return names
+
+
+def import_graph() -> dict[str, dict[str, list[str]]]:
+  """``graph[unit][other]``: the files of ``unit`` that import ``other``."""
+  graph: dict[str, dict[str, list[str]]] = {}
+  for path in sorted(PACKAGE.rglob("*.py")):
+    parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+    module = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+    unit = _unit(module)
+    if unit is None:
+      continue
+    edges = graph.setdefault(unit, {})
+    for other in filter(None, map(_unit, _imported(path, module))):
+      if other != unit:
+        edges.setdefault(other, []).append(str(path.relative_to(PACKAGE.parent)))
+  return graph
+
+
+def find_cycle(graph: dict[str, dict[str, list[str]]]) -> list[str] | None:
+  """A cycle of units (first unit repeated at the end), or None."""
+  state: dict[str, str] = {}
+  stack: list[str] = []
+
+  def visit(unit: str) -> list[str] | None:
+    state[unit] = "open"
+    stack.append(unit)
+    for other in sorted(graph.get(unit, {})):
+      if state.get(other) == "open":
+        return stack[stack.index(other):] + [other]
+      if other not in state and (cycle := visit(other)):
+        return cycle
+    state[unit] = "done"
+    stack.pop()
+    return None
+
+  for unit in sorted(graph):
+    if unit not in state and (cycle := visit(unit)):
+      return cycle
+  return None
+
+
+def test_softbench_units_import_without_a_cycle():
+  graph = import_graph()
+  assert {"robots", "suite", "run", "leaderboard", "records"} <= set(graph)
+  cycle = find_cycle(graph)
+  assert cycle is None, " -> ".join(
+      f"{unit} ({graph[unit][other][0]})" for unit, other in zip(cycle, cycle[1:])) + \
+      f" -> {cycle[-1]}"
+
+
+def test_the_cycle_finder_finds_a_cycle():
+  graph = {"a": {"b": ["a.py"]}, "b": {"c": ["b.py"]}, "c": {"a": ["c.py"]}, "d": {}}
+  assert find_cycle(graph) == ["a", "b", "c", "a"]
+  del graph["c"]["a"]
+  assert find_cycle(graph) is None
+
+
+# The physics side and the environments: tests/test_envs.py.
+@pytest.mark.parametrize("modules", [
+    "softbench.agents, softbench.agents.hyperparameters",
+    "softbench.records, softbench.records.exp1s, softbench.records.provenance",
+    "softbench.leaderboard, softbench.leaderboard.html_page, softbench.leaderboard.overview",
+])
+def test_the_registries_and_the_records_import_without_torch(modules):
+  code = f"import sys, {modules}; print('torch' in sys.modules)"
+  result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          check=True)
+  assert result.stdout.strip() == "False"
