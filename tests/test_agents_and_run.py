@@ -23,13 +23,10 @@ from softbench import suite
 from softbench.agents import forward_models
 from softbench.agents import learned
 
-# Every task of the suite on tendon-2, and one on the pneumatic arm. A task added to the suite
-# gets agent tests here once it has an entry in EPISODE (a KeyError says so until then).
+# Every task of the suite on tendon-2, and one on the pneumatic arm.
 TASKS = tuple(pair for pair in suite.ALL_TASKS if pair[0] == "tendon-2") + (("pneumatic-433",
                                                                             "spiral"),)
-SHORT = {"length": 4}  # Options that shorten each task's episode.
-EPISODE = {"babbling": SHORT, "circle": SHORT, "rectangle": SHORT, "spiral": SHORT,
-           "reach": {"steps": 3}}
+EPISODE_STEPS = 4  # Control steps of each test episode.
 LEARNED_AGENTS = [name for name in agents.AGENTS if agents.describe(name).learned]
 
 
@@ -41,7 +38,7 @@ def shared_home(tmp_path_factory, monkeypatch):
 
 def episode(agent_name, robot, task, seed=0):
   agent = agents.make(agent_name, robot, seed, "tiny")
-  env = suite.load(robot, task, seed=seed, **EPISODE[task])
+  env = suite.load(robot, task, seed=seed, **suite.length_options(task, EPISODE_STEPS))
   return evaluation.run_episode(env, agent, task)
 
 
@@ -49,15 +46,12 @@ def episode(agent_name, robot, task, seed=0):
 @pytest.mark.parametrize("agent_name", agents.AGENTS)
 class TestEveryAgent:
 
-  def test_actions_are_finite_and_in_bounds(self, agent_name, robot, task):
-    actions = episode(agent_name, robot, task).actions
-    assert actions.shape[1] == suite.load(robot, task, **EPISODE[task]).action_spec().shape[0]
-    assert np.all(np.isfinite(actions)) and np.all(np.abs(actions) <= 1.0)
-
-  def test_same_seed_gives_same_actions(self, agent_name, robot, task):
-    # A learned agent is made again from its cached checkpoint here; training itself is checked
-    # by test_training_from_scratch_is_deterministic.
+  def test_actions_are_finite_in_bounds_and_the_same_for_a_seed(self, agent_name, robot, task):
+    # A learned agent is made again from its cached checkpoint the second time; training itself
+    # is checked by test_training_from_scratch_is_deterministic.
     first, second = episode(agent_name, robot, task, 1), episode(agent_name, robot, task, 1)
+    assert first.actions.shape == (EPISODE_STEPS, robots.make(robot).action_dim)
+    assert np.all(np.isfinite(first.actions)) and np.all(np.abs(first.actions) <= 1.0)
     np.testing.assert_array_equal(first.actions, second.actions)
 
 

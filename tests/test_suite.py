@@ -63,15 +63,18 @@ def run_episode(env, seed=0):
 @pytest.mark.parametrize("robot,task", EVERY_TASK)
 class TestEveryTask:
 
-  def test_observations_match_specs_and_are_finite(self, robot, task):
+  def test_observations_match_specs_rewards_lie_in_unit_interval_and_episode_ends(self, robot,
+                                                                                  task):
     env = short_env(robot, task)
     observation_spec = env.observation_spec()
-    observations, _ = run_episode(env)
+    observations, rewards = run_episode(env)
     for observation in observations:
       assert set(observation) == {"poses", "target", "previous_action"}
       for name, value in observation.items():
         observation_spec[name].validate(value)
         assert np.all(np.isfinite(value)), name
+    assert len(rewards) == env.task.num_steps
+    assert all(0.0 <= reward <= 1.0 for reward in rewards)
 
   def test_actions_are_bounded_to_unit_box(self, robot, task):
     spec = short_env(robot, task).action_spec()
@@ -79,12 +82,6 @@ class TestEveryTask:
     assert spec.shape == (robots.make(robot).action_dim,)
     np.testing.assert_array_equal(spec.minimum, -1.0)
     np.testing.assert_array_equal(spec.maximum, 1.0)
-
-  def test_rewards_lie_in_unit_interval_and_episode_ends(self, robot, task):
-    env = short_env(robot, task)
-    _, rewards = run_episode(env)
-    assert len(rewards) == env.task.num_steps
-    assert all(0.0 <= reward <= 1.0 for reward in rewards)
 
   def test_same_seed_gives_same_episode(self, robot, task):
     first, first_rewards = run_episode(short_env(robot, task, seed=3), seed=5)
