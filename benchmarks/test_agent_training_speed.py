@@ -10,10 +10,10 @@ to read is `extra_info["steady_epoch_s"]`: the second epoch of each model (the f
 compiles), summed over an SMPL network's columns, i.e. what one epoch of every model costs.
 """
 
+from collections.abc import Iterator
 import dataclasses
 import pathlib
 import time
-from collections.abc import Iterator
 
 import numpy as np
 import pytest
@@ -44,12 +44,13 @@ def _random_babbling(robot: robots.SoftArm, samples: int) -> data.Dataset:
   """A dataset laid out like a collected one, with uniform random actions and poses."""
   generator = np.random.default_rng(0)
   return dataset_module.Dataset(
-      path=pathlib.Path("random-babbling"),
-      config={"robot": robot.name, "samples": samples},
-      actions=generator.uniform(-1, 1, (samples, robot.action_dim)),
-      poses=generator.uniform(-0.1, 0.1, (samples + _EPISODES, robot.num_modules, 6)),
-      episode_lengths=np.full(_EPISODES, samples // _EPISODES),
-      collection={})
+    path=pathlib.Path("random-babbling"),
+    config={"robot": robot.name, "samples": samples},
+    actions=generator.uniform(-1, 1, (samples, robot.action_dim)),
+    poses=generator.uniform(-0.1, 0.1, (samples + _EPISODES, robot.num_modules, 6)),
+    episode_lengths=np.full(_EPISODES, samples // _EPISODES),
+    collection={},
+  )
 
 
 @pytest.mark.parametrize("robot_name", _ROBOTS)
@@ -70,15 +71,23 @@ def test_closed_loop_training_epoch(benchmark, agent: str, robot_name: str) -> N
   def train() -> None:
     epoch_ends.clear()
     epoch_ends.append(time.perf_counter())
-    learned.train_inverse(views, windows, forwards, seed=0, profile=profile,
-                          per_module=learner.per_module, make_model=learner.make_model,
-                          params=params, on_epoch=lambda *_: epoch_ends.append(time.perf_counter()),
-                          restart_diverged=False)
+    learned.train_inverse(
+      views,
+      windows,
+      forwards,
+      seed=0,
+      profile=profile,
+      per_module=learner.per_module,
+      make_model=learner.make_model,
+      params=params,
+      on_epoch=lambda *_: epoch_ends.append(time.perf_counter()),
+      restart_diverged=False,
+    )
 
   benchmark.pedantic(train, rounds=1, iterations=1)
   epoch_s = np.diff(epoch_ends)
   assert len(epoch_s) == _EPOCHS * len(views)
-  steady = epoch_s[_EPOCHS - 1::_EPOCHS]  # Each model's last epoch.
+  steady = epoch_s[_EPOCHS - 1 :: _EPOCHS]  # Each model's last epoch.
   benchmark.extra_info["training_windows"] = len(windows[-1].train)
   benchmark.extra_info["epoch_s"] = [round(float(s), 2) for s in epoch_s]
   benchmark.extra_info["steady_epoch_s"] = round(float(steady.sum()), 2)

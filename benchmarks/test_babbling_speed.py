@@ -26,8 +26,14 @@ def test_babbling_samples_per_second(benchmark, tmp_path, name):
     return (), {"home": next(homes)}
 
   def collect(home):
-    return data.collect(name, samples=_SAMPLES, workers=workers, home=home, progress=False,
-                        episode_length=_SAMPLES // _EPISODES)
+    return data.collect(
+      name,
+      samples=_SAMPLES,
+      workers=workers,
+      home=home,
+      progress=False,
+      episode_length=_SAMPLES // _EPISODES,
+    )
 
   benchmark.pedantic(collect, setup=fresh_home, rounds=_ROUNDS, iterations=1)
   samples_per_second = _SAMPLES / benchmark.stats.stats.mean

@@ -4,9 +4,9 @@ Goal (issue 2): tendon-5 at least 10x faster than real time on one core.
 """
 
 import mujoco
+from mujoco import rollout
 import numpy as np
 import pytest
-from mujoco import rollout
 
 from softbench import robots
 

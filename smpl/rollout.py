@@ -31,110 +31,117 @@ from torch import Tensor
 from smpl.forward_model import ForwardModel
 from smpl.inverse import InverseModel
 from smpl.progressive import ProgressiveLSTM
-from smpl.windows import BabblingWindows, ModuleWindows, inverse_input_size, inverse_inputs
+from smpl.windows import BabblingWindows
+from smpl.windows import ModuleWindows
+from smpl.windows import inverse_input_size
+from smpl.windows import inverse_inputs
 
 
 @dataclass(frozen=True)
 class Rollout:
-    """What an inverse model did over a batch of windows."""
+  """What an inverse model did over a batch of windows."""
 
-    actions: Tensor
-    """(N, T, action_size) predicted actions a'_t."""
-    errors: Tensor
-    """(N, T, pose_size) the error input e_t each step read (zero at t = 0, and in open loop)."""
-    predicted_poses: Tensor | None
-    """(N, T, pose_size) x'_{t+1} from the forward model, or None without one."""
-    aux_loss: Tensor
-    """Mean over steps of the model's weighted regulariser (zero for deterministic models)."""
+  actions: Tensor
+  """(N, T, action_size) predicted actions a'_t."""
+  errors: Tensor
+  """(N, T, pose_size) the error input e_t each step read (zero at t = 0, and in open loop)."""
+  predicted_poses: Tensor | None
+  """(N, T, pose_size) x'_{t+1} from the forward model, or None without one."""
+  aux_loss: Tensor
+  """Mean over steps of the model's weighted regulariser (zero for deterministic models)."""
 
 
 def rollout(
-    inverse_model: InverseModel,
-    windows: BabblingWindows,
-    forward_model: ForwardModel | None = None,
-    feed_back_error: bool = True,
+  inverse_model: InverseModel,
+  windows: BabblingWindows,
+  forward_model: ForwardModel | None = None,
+  feed_back_error: bool = True,
 ) -> Rollout:
-    """Runs `inverse_model` step by step through every window; see the module docstring."""
-    if feed_back_error and forward_model is None:
-        raise ValueError("closed-loop rollout needs a forward model to compute the pose error")
-    expected_input = inverse_input_size(windows.pose_size, windows.action_size)
-    if inverse_model.input_size != expected_input:
-        raise ValueError(
-            f"the inverse model reads {inverse_model.input_size} features but windows with "
-            f"{windows.pose_size}-D poses and {windows.action_size}-D actions give {expected_input}"
-        )
-    batch_size = len(windows)
-    inverse_state = inverse_model.initial_state(batch_size)
-    forward_state = None if forward_model is None else forward_model.initial_state(batch_size)
-    error = windows.poses.new_zeros(batch_size, windows.pose_size)
-    previous_action = windows.actions.new_zeros(batch_size, windows.action_size)
-    previous_poses = windows.previous_poses.unbind(1)
-    current_poses = windows.current_poses.unbind(1)
-    targets = windows.next_poses.unbind(1)
-    actions, errors, predicted_poses, aux_losses = [], [], [], []
-    for t, target in enumerate(targets):
-        step = inverse_model.step(inverse_inputs(target, error, previous_action), inverse_state)
-        inverse_state = step.state
-        errors.append(error)
-        actions.append(step.action)
-        aux_losses.append(step.aux_loss)
-        if forward_model is not None:
-            predicted_pose, forward_state = forward_model.step(
-                previous_poses[t],
-                current_poses[t],
-                windows.actuation(step.action, t),
-                forward_state,
-            )
-            predicted_poses.append(predicted_pose)
-            if feed_back_error:
-                error = target - predicted_pose
-        previous_action = step.action
-    return Rollout(
-        actions=torch.stack(actions, dim=1),
-        errors=torch.stack(errors, dim=1),
-        predicted_poses=torch.stack(predicted_poses, dim=1) if predicted_poses else None,
-        aux_loss=torch.stack(aux_losses).mean(),
+  """Runs `inverse_model` step by step through every window; see the module docstring."""
+  if feed_back_error and forward_model is None:
+    raise ValueError("closed-loop rollout needs a forward model to compute the pose error")
+  expected_input = inverse_input_size(windows.pose_size, windows.action_size)
+  if inverse_model.input_size != expected_input:
+    raise ValueError(
+      f"the inverse model reads {inverse_model.input_size} features but windows with "
+      f"{windows.pose_size}-D poses and {windows.action_size}-D actions give {expected_input}"
     )
+  batch_size = len(windows)
+  inverse_state = inverse_model.initial_state(batch_size)
+  forward_state = None if forward_model is None else forward_model.initial_state(batch_size)
+  error = windows.poses.new_zeros(batch_size, windows.pose_size)
+  previous_action = windows.actions.new_zeros(batch_size, windows.action_size)
+  previous_poses = windows.previous_poses.unbind(1)
+  current_poses = windows.current_poses.unbind(1)
+  targets = windows.next_poses.unbind(1)
+  actions, errors, predicted_poses, aux_losses = [], [], [], []
+  for t, target in enumerate(targets):
+    step = inverse_model.step(inverse_inputs(target, error, previous_action), inverse_state)
+    inverse_state = step.state
+    errors.append(error)
+    actions.append(step.action)
+    aux_losses.append(step.aux_loss)
+    if forward_model is not None:
+      predicted_pose, forward_state = forward_model.step(
+        previous_poses[t],
+        current_poses[t],
+        windows.actuation(step.action, t),
+        forward_state,
+      )
+      predicted_poses.append(predicted_pose)
+      if feed_back_error:
+        error = target - predicted_pose
+    previous_action = step.action
+  return Rollout(
+    actions=torch.stack(actions, dim=1),
+    errors=torch.stack(errors, dim=1),
+    predicted_poses=torch.stack(predicted_poses, dim=1) if predicted_poses else None,
+    aux_loss=torch.stack(aux_losses).mean(),
+  )
 
 
 def joint_rollout(
-    network: ProgressiveLSTM,
-    windows: ModuleWindows,
-    forward_models: Sequence[ForwardModel],
-    feed_back_error: bool = True,
+  network: ProgressiveLSTM,
+  windows: ModuleWindows,
+  forward_models: Sequence[ForwardModel],
+  feed_back_error: bool = True,
 ) -> list[Rollout]:
-    """Runs columns 0..len(windows.modules)-1 together, column j on module j's own inputs.
+  """Runs columns 0..len(windows.modules)-1 together, column j on module j's own inputs.
 
-    The same loop as `rollout`, for every module at once: at step t column j reads
-    [x^j_{t+1}, e^j_t, a'^j_{t-1}], one `step_columns` call gives every column's action, and
-    module j's forward model turns a'^j_t into the next error e^j_{t+1}. Through the lateral
-    connections a distal column sees the proximal columns' features of their own targets and
-    errors, which its module's pose depends on.
-    """
-    modules = windows.modules
-    if len(forward_models) != len(modules):
-        raise ValueError(f"{len(modules)} modules need as many forward models, got "
-                         f"{len(forward_models)}")
-    batch_size = len(windows)
-    state = network.initial_state(batch_size, len(modules) - 1)
-    forward_states = [model.initial_state(batch_size) for model in forward_models]
-    errors = [w.poses.new_zeros(batch_size, w.pose_size) for w in modules]
-    previous = [w.actions.new_zeros(batch_size, w.action_size) for w in modules]
-    history = [([], [], []) for _ in modules]  # actions, errors, predicted poses
-    for t in range(windows.modules[0].steps):
-        inputs = [inverse_inputs(w.next_poses[:, t], error, action)
-                  for w, error, action in zip(modules, errors, previous)]
-        actions, state = network.step_columns(inputs, state, len(modules) - 1)
-        for j, (w, model, action) in enumerate(zip(modules, forward_models, actions)):
-            predicted, forward_states[j] = model.step(
-                w.previous_poses[:, t], w.current_poses[:, t], w.actuation(action, t),
-                forward_states[j])
-            history[j][0].append(action)
-            history[j][1].append(errors[j])
-            history[j][2].append(predicted)
-            if feed_back_error:
-                errors[j] = w.next_poses[:, t] - predicted
-        previous = actions
-    zero = modules[0].actions.new_zeros(())
-    return [Rollout(torch.stack(a, 1), torch.stack(e, 1), torch.stack(p, 1), zero)
-            for a, e, p in history]
+  The same loop as `rollout`, for every module at once: at step t column j reads
+  [x^j_{t+1}, e^j_t, a'^j_{t-1}], one `step_columns` call gives every column's action, and
+  module j's forward model turns a'^j_t into the next error e^j_{t+1}. Through the lateral
+  connections a distal column sees the proximal columns' features of their own targets and
+  errors, which its module's pose depends on.
+  """
+  modules = windows.modules
+  if len(forward_models) != len(modules):
+    raise ValueError(
+      f"{len(modules)} modules need as many forward models, got {len(forward_models)}"
+    )
+  batch_size = len(windows)
+  state = network.initial_state(batch_size, len(modules) - 1)
+  forward_states = [model.initial_state(batch_size) for model in forward_models]
+  errors = [w.poses.new_zeros(batch_size, w.pose_size) for w in modules]
+  previous = [w.actions.new_zeros(batch_size, w.action_size) for w in modules]
+  history = [([], [], []) for _ in modules]  # actions, errors, predicted poses
+  for t in range(windows.modules[0].steps):
+    inputs = [
+      inverse_inputs(w.next_poses[:, t], error, action)
+      for w, error, action in zip(modules, errors, previous)
+    ]
+    actions, state = network.step_columns(inputs, state, len(modules) - 1)
+    for j, (w, model, action) in enumerate(zip(modules, forward_models, actions)):
+      predicted, forward_states[j] = model.step(
+        w.previous_poses[:, t], w.current_poses[:, t], w.actuation(action, t), forward_states[j]
+      )
+      history[j][0].append(action)
+      history[j][1].append(errors[j])
+      history[j][2].append(predicted)
+      if feed_back_error:
+        errors[j] = w.next_poses[:, t] - predicted
+    previous = actions
+  zero = modules[0].actions.new_zeros(())
+  return [
+    Rollout(torch.stack(a, 1), torch.stack(e, 1), torch.stack(p, 1), zero) for a, e, p in history
+  ]

@@ -1,8 +1,8 @@
 """softbench: a MuJoCo + dm_control benchmark suite for controllers of modular soft robot arms."""
 
+from collections.abc import Iterator
 import ctypes.util
 import os
-from collections.abc import Iterator
 
 # MuJoCo loads the OpenGL backend named by MUJOCO_GL when it is imported. Headless by default:
 # EGL where its library is installed, else OSMesa; a user may still choose another.

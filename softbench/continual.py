@@ -43,8 +43,12 @@ from softbench.agents import hyperparameters
 from softbench.agents import learned
 from softbench.data import dataset
 from softbench.records import provenance
-from softbench.records.exp1s import FORGETTING_TASK, LOOPS, METRICS, PROTOCOL, TASKS
+from softbench.records.exp1s import FORGETTING_TASK
 from softbench.records.exp1s import FORMAT as RECORD_FORMAT
+from softbench.records.exp1s import LOOPS
+from softbench.records.exp1s import METRICS
+from softbench.records.exp1s import PROTOCOL
+from softbench.records.exp1s import TASKS
 from softbench.records.exp1s import VERSION as RECORD_VERSION
 
 DEFAULT_FAMILY = "tendon"
@@ -54,8 +58,9 @@ def protocol(family: str = DEFAULT_FAMILY) -> protocols.Protocol:
   """Exp1S on the arms of tendon family ``family``; raises a one-line ValueError for an unknown
   family."""
   if family not in robots.TENDON_FAMILIES:
-    raise ValueError(f"unknown tendon family {family!r}; choose one of "
-                     f"{', '.join(robots.TENDON_FAMILIES)}")
+    raise ValueError(
+      f"unknown tendon family {family!r}; choose one of {', '.join(robots.TENDON_FAMILIES)}"
+    )
   return protocols.get(PROTOCOL).on_family(family)
 
 
@@ -100,10 +105,16 @@ class Exp1sModel:
 
 
 def _config(seed: int, profile: profiles.Profile, arms: list) -> Exp1sConfig:
-  return Exp1sConfig(tuple(arm.name for arm in arms),
-                     tuple(hashlib.sha256(arm.to_xml().encode()).hexdigest() for arm in arms),
-                     profile.samples, seed, profile.max_epochs, profile.patience, profile.compile,
-                     tuple(sorted(_params(arms[-1].name).items())))
+  return Exp1sConfig(
+    tuple(arm.name for arm in arms),
+    tuple(hashlib.sha256(arm.to_xml().encode()).hexdigest() for arm in arms),
+    profile.samples,
+    seed,
+    profile.max_epochs,
+    profile.patience,
+    profile.compile,
+    tuple(sorted(_params(arms[-1].name).items())),
+  )
 
 
 def _params(last_robot: str) -> dict:
@@ -115,32 +126,49 @@ def _params(last_robot: str) -> dict:
 def _train(seed: int, profile: profiles.Profile, show: bool, family: str):
   """Column by column over the configurations; returns network, forwards, normalisations, run."""
   sequence = protocol(family)
-  forward_config, inverse_config = learned.training_configs(seed, profile,
-                                                            _params(sequence.robot_names[-1]))
-  progress_bars = lambda label: learned.progress_bar(f"{label} ({PROTOCOL} seed {seed})",
-                                                     profile.max_epochs, show)
-  result = protocols.run(sequence, profile.samples, learned.DATA_SEED,
-                         forward_config, inverse_config, training.default_device(), show,
-                         progress_bars)
+  forward_config, inverse_config = learned.training_configs(
+    seed, profile, _params(sequence.robot_names[-1])
+  )
+  progress_bars = lambda label: learned.progress_bar(
+    f"{label} ({PROTOCOL} seed {seed})", profile.max_epochs, show
+  )
+  result = protocols.run(
+    sequence,
+    profile.samples,
+    learned.DATA_SEED,
+    forward_config,
+    inverse_config,
+    training.default_device(),
+    show,
+    progress_bars,
+  )
   result.network.requires_grad_(False)
-  return (result.network, [column.forward_model for column in result.columns],
-          [column.windows.normalisation for column in result.columns], result.run)
+  return (
+    result.network,
+    [column.forward_model for column in result.columns],
+    [column.windows.normalisation for column in result.columns],
+    result.run,
+  )
 
 
 def _matrices(outcome: smpl_protocol.ProgressiveRun) -> dict[str, np.ndarray]:
-  return {f"forgetting/{metric}": outcome.forgetting_matrix(metric).numpy()
-          for metric in ("pose_mse", "action_mse")}
+  return {
+    f"forgetting/{metric}": outcome.forgetting_matrix(metric).numpy()
+    for metric in ("pose_mse", "action_mse")
+  }
 
 
-def checkpoint_path(seed: int, profile: profiles.Profile,
-                    family: str = DEFAULT_FAMILY) -> pathlib.Path:
+def checkpoint_path(
+  seed: int, profile: profiles.Profile, family: str = DEFAULT_FAMILY
+) -> pathlib.Path:
   """Where ``build`` caches the Exp1S network of ``seed`` (it exists once trained)."""
   arms = [arm for arm, _ in protocol(family).column_views()]
   return learned.checkpoint_file(_config(seed, profile, arms))
 
 
-def build(seed: int, profile: profiles.Profile, show_progress: bool = False,
-          family: str = DEFAULT_FAMILY) -> Exp1sModel:
+def build(
+  seed: int, profile: profiles.Profile, show_progress: bool = False, family: str = DEFAULT_FAMILY
+) -> Exp1sModel:
   """The Exp1S network of ``seed``: from the checkpoint cache, or trained now and cached."""
   views_of = protocol(family).column_views()
   arms = [arm for arm, _ in views_of]
@@ -151,17 +179,23 @@ def build(seed: int, profile: profiles.Profile, show_progress: bool = False,
     network, forwards, normalisations, outcome = _train(seed, profile, show_progress, family)
     return learned.TrainedModels(network, forwards, normalisations, _matrices(outcome))
 
-  models = learned.load_or_train(learned.checkpoint_file(config), config,
-                                 [arm.name for arm in arms],
-                                 lambda: learned.untrained(views, True, None,
-                                                           _params(arms[-1].name)), train)
+  models = learned.load_or_train(
+    learned.checkpoint_file(config),
+    config,
+    [arm.name for arm in arms],
+    lambda: learned.untrained(views, True, None, _params(arms[-1].name)),
+    train,
+  )
   network, forwards, normalisations = models.inverse, models.forwards, models.normalisations
   matrices = models.arrays
   network.eval()
-  controllers = [learned.Controller(view, forward.eval(), scale)
-                 for view, forward, scale in zip(views, forwards, normalisations)]
-  return Exp1sModel(network, controllers, arms, matrices["forgetting/pose_mse"],
-                    matrices["forgetting/action_mse"])
+  controllers = [
+    learned.Controller(view, forward.eval(), scale)
+    for view, forward, scale in zip(views, forwards, normalisations)
+  ]
+  return Exp1sModel(
+    network, controllers, arms, matrices["forgetting/pose_mse"], matrices["forgetting/action_mse"]
+  )
 
 
 class ForgettingDetected(RuntimeError):
@@ -176,10 +210,11 @@ def check_no_forgetting(matrix: np.ndarray) -> None:
     for configuration in range(stage):
       if matrix[stage, configuration] != matrix[configuration, configuration]:
         raise ForgettingDetected(
-            f"configuration {configuration + 1} changed after stage {stage + 1}: "
-            f"{float(matrix[configuration, configuration])!r} -> "
-            f"{float(matrix[stage, configuration])!r}, "
-            f"though its column is frozen (a defect of softbench; please report it)")
+          f"configuration {configuration + 1} changed after stage {stage + 1}: "
+          f"{float(matrix[configuration, configuration])!r} -> "
+          f"{float(matrix[stage, configuration])!r}, "
+          f"though its column is frozen (a defect of softbench; please report it)"
+        )
 
 
 def _end_effector_scores(episode: episodes.Episode, length: float) -> dict:
@@ -187,19 +222,20 @@ def _end_effector_scores(episode: episodes.Episode, length: float) -> dict:
   return {name: getattr(score, name)[-1].mean for name in METRICS if getattr(score, name)}
 
 
-def finished_seeds_folder(profile: profiles.Profile,
-                          family: str = DEFAULT_FAMILY) -> pathlib.Path:
+def finished_seeds_folder(profile: profiles.Profile, family: str = DEFAULT_FAMILY) -> pathlib.Path:
   """Where the scores of the seeds (and, under ``EPISODES_FOLDER``, of the episodes) that an
   interrupted run finished are kept (``episode_snapshots``: keyed by the settings and the code)."""
   return episode_snapshots.keyed_folder(
-      f"smpl-{PROTOCOL}", (dataclasses.asdict(profile), protocol(family).robot_names))
+    f"smpl-{PROTOCOL}", (dataclasses.asdict(profile), protocol(family).robot_names)
+  )
 
 
 EPISODES_FOLDER = "episodes"  # Inside finished_seeds_folder: the finished episodes of a seed.
 
 
-def run_seed(seed: int, profile: profiles.Profile, family: str = DEFAULT_FAMILY,
-             show_progress: bool = False) -> dict:
+def run_seed(
+  seed: int, profile: profiles.Profile, family: str = DEFAULT_FAMILY, show_progress: bool = False
+) -> dict:
   """``score_seed``, or the scores an interrupted run of the same settings and code kept: the
   seed's, or those of each episode it had finished."""
   folder = finished_seeds_folder(profile, family)
@@ -210,15 +246,23 @@ def run_seed(seed: int, profile: profiles.Profile, family: str = DEFAULT_FAMILY,
     kept = len(list(episodes.glob(f"seed{seed}-*.json")))
     if kept and show_progress:
       total = len(protocol(family).robot_names) * len(LOOPS) * len(TASKS)
-      print(f"resuming seed {seed}: {kept} of its {total} episodes finished before the run was "
-            "interrupted", file=sys.stderr)
+      print(
+        f"resuming seed {seed}: {kept} of its {total} episodes finished before the run was "
+        "interrupted",
+        file=sys.stderr,
+      )
     scores = score_seed(seed, profile, show_progress, episodes, family)
     episode_snapshots.save_scores(path, scores, subject)
   return scores
 
 
-def score_seed(seed: int, profile: profiles.Profile, show_progress: bool,
-               kept_episodes: pathlib.Path, family: str = DEFAULT_FAMILY) -> dict:
+def score_seed(
+  seed: int,
+  profile: profiles.Profile,
+  show_progress: bool,
+  kept_episodes: pathlib.Path,
+  family: str = DEFAULT_FAMILY,
+) -> dict:
   """Trains (or loads) seed ``seed``'s network and scores every configuration, task and loop.
 
   Each episode's scores are kept in ``kept_episodes`` as it ends, and an episode whose scores
@@ -242,8 +286,9 @@ def score_seed(seed: int, profile: profiles.Profile, show_progress: bool,
         path = kept_episodes / f"{name}.json"
         entry = episode_snapshots.load_scores(path, subject)
         if entry is None:
-          env = suite.load(arm, task, seed=seed,
-                           **suite.length_options(task, profile.episode_length))
+          env = suite.load(
+            arm, task, seed=seed, **suite.length_options(task, profile.episode_length)
+          )
           episode = evaluation.run_episode(env, agent, task, show_progress)
           entry = _end_effector_scores(episode, arm.length)
           episode_snapshots.save_scores(path, entry, subject)
@@ -251,17 +296,26 @@ def score_seed(seed: int, profile: profiles.Profile, show_progress: bool,
   tip = [entry["normalised_tip_percent"] for entry in scores["closed"][FORGETTING_TASK]]
   stages = len(model.arms)
   physics = [[tip[c] if c <= s else None for c in range(stages)] for s in range(stages)]
-  model_level = [[None if np.isnan(value) else float(value) for value in row]
-                 for row in model.forgetting_pose_mse]
-  return {"seed": seed, "scores": scores, "forgetting_model_pose_mse": model_level,
-          "forgetting_tip_percent": physics}
+  model_level = [
+    [None if np.isnan(value) else float(value) for value in row]
+    for row in model.forgetting_pose_mse
+  ]
+  return {
+    "seed": seed,
+    "scores": scores,
+    "forgetting_model_pose_mse": model_level,
+    "forgetting_tip_percent": physics,
+  }
 
 
-
-
-def execute(profile: profiles.Profile, seeds: int | None = None, show_progress: bool = True,
-            workers: int | None = None, keep_seeds: bool = False,
-            family: str = DEFAULT_FAMILY) -> dict:
+def execute(
+  profile: profiles.Profile,
+  seeds: int | None = None,
+  show_progress: bool = True,
+  workers: int | None = None,
+  keep_seeds: bool = False,
+  family: str = DEFAULT_FAMILY,
+) -> dict:
   """Every seed (in parallel processes), then the result record with full provenance.
 
   Each finished seed's scores are kept until the end, so that an interrupted run resumes with
@@ -278,23 +332,38 @@ def execute(profile: profiles.Profile, seeds: int | None = None, show_progress: 
     data.collect(arm, samples=profile.samples, seed=learned.DATA_SEED, progress=show_progress)
   if show_progress:
     episode_snapshots.report_resuming(finished_seeds_folder(profile, family), seeds)
-  per_seed = parallel_seeds.over_seeds(run_seed, seeds, (profile, family), f"smpl {PROTOCOL}",
-                            show_progress, workers)
+  per_seed = parallel_seeds.over_seeds(
+    run_seed, seeds, (profile, family), f"smpl {PROTOCOL}", show_progress, workers
+  )
   if not keep_seeds:
     episode_snapshots.discard_folder(finished_seeds_folder(profile, family))
-  return {"format": RECORD_FORMAT, "version": RECORD_VERSION, **origin,
-          "protocol": PROTOCOL, "agent": "smpl",
-          "robots": list(sequence.robot_names),
-          "tasks": list(TASKS), "profile": profile.name,
-          "profile_settings": dataclasses.asdict(profile), "seeds": seeds, "per_seed": per_seed,
-          **zoo.section(taken), "wall_time_s": round(time.perf_counter() - started, 3)}
+  return {
+    "format": RECORD_FORMAT,
+    "version": RECORD_VERSION,
+    **origin,
+    "protocol": PROTOCOL,
+    "agent": "smpl",
+    "robots": list(sequence.robot_names),
+    "tasks": list(TASKS),
+    "profile": profile.name,
+    "profile_settings": dataclasses.asdict(profile),
+    "seeds": seeds,
+    "per_seed": per_seed,
+    **zoo.section(taken),
+    "wall_time_s": round(time.perf_counter() - started, 3),
+  }
 
 
 def mean_forgetting(record: dict) -> np.ndarray:
   """The physics forgetting matrix (stages x configurations, normalised tip error in %), mean
   over seeds; NaN for configurations not yet seen."""
-  matrices = [[[np.nan if value is None else value for value in row]
-               for row in seed["forgetting_tip_percent"]] for seed in record["per_seed"]]
+  matrices = [
+    [
+      [np.nan if value is None else value for value in row]
+      for row in seed["forgetting_tip_percent"]
+    ]
+    for seed in record["per_seed"]
+  ]
   return np.mean(np.array(matrices, dtype=float), axis=0)
 
 
@@ -307,14 +376,21 @@ def table(record: dict) -> str:
   """The paper's Exp1S layout: per loop, configurations by rows, per task position (mm) and
   orientation (deg) of the end effector; then normalised tip error; then the forgetting matrix."""
   per_seed, configurations = record["per_seed"], len(record["robots"])
-  lines = [f"smpl {record['protocol']} ({', '.join(record['robots'])}), profile "
-           f"{record['profile']}, {record['seeds']} seed(s), end effector in physics: "
-           f"mean ± std over seeds"]
-  for metric, label in (("position_mm", "position (mm) / orientation (deg)"),
-                        ("normalised_tip_percent", "normalised tip error (%)")):
+  lines = [
+    f"smpl {record['protocol']} ({', '.join(record['robots'])}), profile "
+    f"{record['profile']}, {record['seeds']} seed(s), end effector in physics: "
+    f"mean ± std over seeds"
+  ]
+  for metric, label in (
+    ("position_mm", "position (mm) / orientation (deg)"),
+    ("normalised_tip_percent", "normalised tip error (%)"),
+  ):
     for loop in LOOPS:
-      lines += ["", f"{loop} loop, {label}",
-                f"{'config':<8}" + "".join(f"{task:>22}" for task in record["tasks"])]
+      lines += [
+        "",
+        f"{loop} loop, {label}",
+        f"{'config':<8}" + "".join(f"{task:>22}" for task in record["tasks"]),
+      ]
       for index in range(configurations):
         cells = []
         for task in record["tasks"]:
@@ -324,12 +400,19 @@ def table(record: dict) -> str:
             cell += f" / {metrics.Statistic.of(value('orientation_deg')).mean:.1f}"
           cells.append(f"{cell:>22}")
         lines.append(f"{index + 1:<8}" + "".join(cells))
-  lines += ["", f"forgetting matrix: normalised tip error (%) on {FORGETTING_TASK}, closed loop, "
-                f"of each configuration (columns) after each stage (rows)",
-            f"{'stage':<8}" + "".join(f"{c + 1:>16}" for c in range(configurations))]
+  lines += [
+    "",
+    f"forgetting matrix: normalised tip error (%) on {FORGETTING_TASK}, closed loop, "
+    f"of each configuration (columns) after each stage (rows)",
+    f"{'stage':<8}" + "".join(f"{c + 1:>16}" for c in range(configurations)),
+  ]
   for stage in range(configurations):
-    cells = [_statistic([seed["forgetting_tip_percent"][stage][c] for seed in per_seed])
-             if c <= stage else "" for c in range(configurations)]
+    cells = [
+      _statistic([seed["forgetting_tip_percent"][stage][c] for seed in per_seed])
+      if c <= stage
+      else ""
+      for c in range(configurations)
+    ]
     lines.append(f"{stage + 1:<8}" + "".join(f"{cell:>16}" for cell in cells))
   lines.append(f"wall time {record['wall_time_s']:.1f} s")
   return "\n".join(lines)
@@ -344,6 +427,12 @@ def record_path(record: dict, results: pathlib.Path) -> pathlib.Path:
   """``smpl-exp1s-PROFILE-DATE.json`` on the default family, ``smpl-exp1s-FAMILY-PROFILE-DATE``
   on another."""
   family = family_of(record)
-  name = "-".join([f"smpl-{record['protocol']}", *([family] if family != DEFAULT_FAMILY else []),
-                   record["profile"], provenance.date_stamp(record)])
+  name = "-".join(
+    [
+      f"smpl-{record['protocol']}",
+      *([family] if family != DEFAULT_FAMILY else []),
+      record["profile"],
+      provenance.date_stamp(record),
+    ]
+  )
   return results / f"{name}.json"

@@ -22,8 +22,8 @@ import numpy as np
 import torch
 
 import smpl
-import softbench
 from smpl import training
+import softbench
 from softbench import episodes
 from softbench import storage
 from softbench.data import dataset
@@ -78,8 +78,9 @@ def report_resuming(path: pathlib.Path, seeds: int) -> None:
   """Says on stderr how many of ``seeds`` seeds an interrupted run left in ``path``, if any."""
   saved = len(list(path.glob("seed*")))
   if saved:
-    print(f"resuming: {saved} of {seeds} seeds finished before the run was interrupted",
-          file=sys.stderr)
+    print(
+      f"resuming: {saved} of {seeds} seeds finished before the run was interrupted", file=sys.stderr
+    )
 
 
 def _keep(path: pathlib.Path, content: bytes | str, subject: str, what: str) -> None:
@@ -89,8 +90,10 @@ def _keep(path: pathlib.Path, content: bytes | str, subject: str, what: str) -> 
   try:
     storage.write_atomically(path, content)
   except OSError as error:
-    warnings.warn(f"could not keep the {what} of {subject} at {path} "
-                  f"({error.strerror or error}); the run goes on without it")
+    warnings.warn(
+      f"could not keep the {what} of {subject} at {path} "
+      f"({error.strerror or error}); the run goes on without it"
+    )
 
 
 def _owner(path: pathlib.Path) -> str:
@@ -117,14 +120,16 @@ def load(run, seed: int) -> episodes.Episode | None:
   """``seed``'s episode saved by an interrupted run of the same settings and code, or None. An
   unreadable or altered file is deleted with a warning (``storage.read_cached``; the seed then
   runs again)."""
+
   def read(path: pathlib.Path) -> episodes.Episode:
     arrays = dataset.read_npz(path.read_bytes(), ValueError)
     expected = str(arrays.pop("sha256"))
     if expected != storage.arrays_sha256(arrays):
       raise ValueError("content hash mismatch")
     _check_owner(str(arrays.pop("owner")), path)
-    return episodes.Episode(run.task, tuple(int(k) for k in arrays["scored_modules"]),
-                              *(arrays[name] for name in _ARRAYS))
+    return episodes.Episode(
+      run.task, tuple(int(k) for k in arrays["scored_modules"]), *(arrays[name] for name in _ARRAYS)
+    )
 
   return storage.read_cached(_path(run, seed), read, "saved episode", f"seed {seed} runs again")
 
@@ -145,6 +150,7 @@ def load_scores(path: pathlib.Path, subject: str) -> dict | None:
   """The scores of ``subject`` that an interrupted run saved at ``path``, or None; an unreadable
   or altered file is deleted with a warning (``storage.read_cached``; ``subject`` then runs
   again)."""
+
   def read(found: pathlib.Path) -> dict:
     saved = json.loads(found.read_text())
     owned = {"scores": saved["scores"], "owner": saved["owner"]}

@@ -4,8 +4,8 @@ At every control step the agent sees the observation, its action is applied for 
 period, and the pose each scored module reached is compared with the target it was shown.
 """
 
-import numpy as np
 from dm_control.rl import control
+import numpy as np
 
 from softbench import agents
 from softbench import episodes
@@ -16,8 +16,9 @@ def agent_label(agent: agents.Agent) -> str:
   return f"{type(agent).__name__} seed {agent.seed}"
 
 
-def run_episode(env: control.Environment, agent: agents.Agent, task: str,
-                show_progress: bool = False) -> episodes.Episode:
+def run_episode(
+  env: control.Environment, agent: agents.Agent, task: str, show_progress: bool = False
+) -> episodes.Episode:
   """One episode of ``env`` driven by ``agent``.
 
   Raises:
@@ -41,5 +42,12 @@ def run_episode(env: control.Environment, agent: agents.Agent, task: str,
       rewards.append(time_step.reward)
       progress.advance(bar)
   poses = np.array(poses)
-  return episodes.Episode(task, scored, np.array(targets), poses[1:, np.array(scored) - 1], poses,
-                 np.array(actions), np.array(rewards))
+  return episodes.Episode(
+    task,
+    scored,
+    np.array(targets),
+    poses[1:, np.array(scored) - 1],
+    poses,
+    np.array(actions),
+    np.array(rewards),
+  )

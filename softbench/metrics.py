@@ -23,8 +23,10 @@ PERCENT = 100.0
 def _split(poses: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
   poses = np.asarray(poses, dtype=float)
   if poses.shape[-1] not in (3, 6):
-    raise ValueError(f"poses must end in 3 (position) or 6 (position, orientation) entries, "
-                     f"got shape {poses.shape}")
+    raise ValueError(
+      f"poses must end in 3 (position) or 6 (position, orientation) entries, "
+      f"got shape {poses.shape}"
+    )
   return poses[..., :3], (poses[..., 3:] if poses.shape[-1] == 6 else None)
 
 
@@ -49,8 +51,9 @@ def orientation_error_deg(achieved: np.ndarray, target: np.ndarray) -> np.ndarra
   return np.degrees(np.arctan2(sine, cosine))
 
 
-def normalised_tip_error_percent(achieved: np.ndarray, target: np.ndarray,
-                                 robot_length: float) -> np.ndarray:
+def normalised_tip_error_percent(
+  achieved: np.ndarray, target: np.ndarray, robot_length: float
+) -> np.ndarray:
   """Position error as a percentage of the robot's length (m)."""
   if not robot_length > 0:
     raise ValueError(f"robot_length must be positive, got {robot_length}")
@@ -88,8 +91,9 @@ class TrackingScore:
     per_module = getattr(self, metric)
     if not per_module:
       raise ValueError(f"{metric} was not measured")
-    return Statistic(float(np.mean([s.mean for s in per_module])),
-                     float(np.mean([s.std for s in per_module])))
+    return Statistic(
+      float(np.mean([s.mean for s in per_module])), float(np.mean([s.std for s in per_module]))
+    )
 
 
 def score(achieved: np.ndarray, target: np.ndarray, robot_length: float) -> TrackingScore:
@@ -98,14 +102,17 @@ def score(achieved: np.ndarray, target: np.ndarray, robot_length: float) -> Trac
   achieved = np.asarray(achieved, dtype=float)
   target = np.asarray(target, dtype=float)
   if achieved.ndim != 3 or target.ndim != 3 or achieved.shape[:2] != target.shape[:2]:
-    raise ValueError(f"achieved and target must be (steps, modules, pose) with the same steps and "
-                     f"modules, got {achieved.shape} and {target.shape}")
+    raise ValueError(
+      f"achieved and target must be (steps, modules, pose) with the same steps and "
+      f"modules, got {achieved.shape} and {target.shape}"
+    )
   per_module = lambda errors: tuple(Statistic.of(errors[:, k]) for k in range(errors.shape[1]))
   position_only = target.shape[-1] == 3
   achieved_compared = achieved[..., :3] if position_only else achieved
   return TrackingScore(
-      position_mm=per_module(position_error_mm(achieved_compared, target)),
-      orientation_deg=() if position_only else per_module(orientation_error_deg(achieved, target)),
-      normalised_tip_percent=per_module(
-          normalised_tip_error_percent(achieved_compared, target, robot_length)))
-
+    position_mm=per_module(position_error_mm(achieved_compared, target)),
+    orientation_deg=() if position_only else per_module(orientation_error_deg(achieved, target)),
+    normalised_tip_percent=per_module(
+      normalised_tip_error_percent(achieved_compared, target, robot_length)
+    ),
+  )

@@ -69,8 +69,9 @@ def in_processes(function, arguments: list[tuple], label: str, workers: int) -> 
     WorkerDied: a worker process ended without a result.
   """
   progress = progress_bars.counting()
-  executor = futures.ProcessPoolExecutor(workers, multiprocessing.get_context("spawn"),
-                                         initializer=_init_worker)
+  executor = futures.ProcessPoolExecutor(
+    workers, multiprocessing.get_context("spawn"), initializer=_init_worker
+  )
   try:
     with progress:
       bar = progress.add_task(f"{label} ({workers} processes)", total=len(arguments))
@@ -83,8 +84,10 @@ def in_processes(function, arguments: list[tuple], label: str, workers: int) -> 
       progress.update(bar, completed=len(arguments))
   except futures.process.BrokenProcessPool:
     _terminate(executor)
-    raise WorkerDied(f"a worker process of {label} ended without a result (killed, or out of "
-                     f"memory?); run the same command again to resume") from None
+    raise WorkerDied(
+      f"a worker process of {label} ended without a result (killed, or out of "
+      f"memory?); run the same command again to resume"
+    ) from None
   except BaseException:  # A worker's error, or Ctrl-C: the other workers stop at once.
     _terminate(executor)
     raise
@@ -101,8 +104,9 @@ def _terminate(executor: futures.ProcessPoolExecutor) -> None:
   executor.shutdown(wait=True, cancel_futures=True)
 
 
-def over_seeds(function, seeds: int, arguments: tuple, label: str, show_progress: bool,
-                workers: int | None) -> list:
+def over_seeds(
+  function, seeds: int, arguments: tuple, label: str, show_progress: bool, workers: int | None
+) -> list:
   """``function(seed, *arguments, show)`` for seeds 0..seeds-1, in ``workers`` processes (default:
   one per core), never more than there are seeds; each seed computes with
   ``smpl.training.CPU_THREADS`` torch threads, in this process or a worker."""
@@ -110,7 +114,8 @@ def over_seeds(function, seeds: int, arguments: tuple, label: str, show_progress
     dataset.check_count("workers", workers)
   workers = min(seeds, workers or os.cpu_count() or 1)
   if workers > 1:
-    return in_processes(function, [(seed, *arguments, False) for seed in range(seeds)],
-                     f"{label}: seeds", workers)
+    return in_processes(
+      function, [(seed, *arguments, False) for seed in range(seeds)], f"{label}: seeds", workers
+    )
   with training.limited_cpu_threads(training.CPU_THREADS, torch.device("cpu")):
     return [function(seed, *arguments, show_progress) for seed in range(seeds)]

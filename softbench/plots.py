@@ -15,10 +15,10 @@ import pathlib
 from typing import Sequence
 
 import matplotlib
-import numpy as np
 from matplotlib import colors as mpl_colors
 from matplotlib import ticker
 from matplotlib.figure import Figure
+import numpy as np
 
 from softbench import episodes
 from softbench import metrics
@@ -54,8 +54,12 @@ def _module_colours(robot: base.SoftArm | None, modules: Sequence[int]) -> list:
   return [tuple(colours[module - 1][:3]) for module in modules]
 
 
-def tracking_paths(episode: episodes.Episode, path: str | pathlib.Path, title: str = "",
-                   robot: base.SoftArm | None = None) -> pathlib.Path:
+def tracking_paths(
+  episode: episodes.Episode,
+  path: str | pathlib.Path,
+  title: str = "",
+  robot: base.SoftArm | None = None,
+) -> pathlib.Path:
   """Saves target (dashed) and achieved (solid) tip paths in mm, a 3-D panel per scored module,
   starting at the pose before the first step. A target held all episode is drawn as a star.
   Axes share one scale (see ``MIN_AXIS_SHARE``)."""
@@ -63,8 +67,9 @@ def tracking_paths(episode: episodes.Episode, path: str | pathlib.Path, title: s
   colours = _module_colours(robot, modules)
   columns = min(len(modules), MAX_PANEL_COLUMNS)
   rows = math.ceil(len(modules) / columns)
-  figure = Figure(figsize=(PANEL_INCHES * columns, PANEL_INCHES * rows * 0.8 + 0.4),
-                  layout="constrained")
+  figure = Figure(
+    figsize=(PANEL_INCHES * columns, PANEL_INCHES * rows * 0.8 + 0.4), layout="constrained"
+  )
   errors = metrics.position_error_mm(episode.achieved[..., :3], episode.targets[..., :3])
   for index, module in enumerate(modules):
     axes = figure.add_subplot(rows, columns, index + 1, projection="3d")
@@ -92,8 +97,12 @@ def tracking_paths(episode: episodes.Episode, path: str | pathlib.Path, title: s
   return _save(figure, path)
 
 
-def tracking_errors(episodes: Sequence[episodes.Episode], path: str | pathlib.Path,
-                    title: str = "", robot: base.SoftArm | None = None) -> pathlib.Path:
+def tracking_errors(
+  episodes: Sequence[episodes.Episode],
+  path: str | pathlib.Path,
+  title: str = "",
+  robot: base.SoftArm | None = None,
+) -> pathlib.Path:
   """Saves position error (mm), and orientation error (deg) for 6-D targets, over control steps:
   a line per module and episode (seed), the first episode's drawn solid, the others fainter."""
   if not episodes:
@@ -101,11 +110,16 @@ def tracking_errors(episodes: Sequence[episodes.Episode], path: str | pathlib.Pa
   modules = episodes[0].scored_modules
   colours = _module_colours(robot, modules)
   with_orientation = episodes[0].targets.shape[-1] == 6
-  panels = [("position error (mm)", lambda e: metrics.position_error_mm(
-      e.achieved[..., :3], e.targets[..., :3]))]
+  panels = [
+    (
+      "position error (mm)",
+      lambda e: metrics.position_error_mm(e.achieved[..., :3], e.targets[..., :3]),
+    )
+  ]
   if with_orientation:
-    panels.append(("orientation error (deg)",
-                   lambda e: metrics.orientation_error_deg(e.achieved, e.targets)))
+    panels.append(
+      ("orientation error (deg)", lambda e: metrics.orientation_error_deg(e.achieved, e.targets))
+    )
   figure = Figure(figsize=(8.0, 2.8 * len(panels) + 0.6), layout="constrained")
   all_axes = figure.subplots(len(panels), 1, sharex=True, squeeze=False)[:, 0]
   for axes, (label, error) in zip(all_axes, panels):
@@ -113,25 +127,34 @@ def tracking_errors(episodes: Sequence[episodes.Episode], path: str | pathlib.Pa
       values = error(episode)
       steps = np.arange(1, len(values) + 1)
       for index, module in enumerate(modules):
-        axes.plot(steps, values[:, index], color=colours[index],
-                  alpha=1.0 if seed == 0 else OTHER_SEED_ALPHA,
-                  linewidth=1.4 if seed == 0 else 0.9,
-                  label=f"module {module}" if seed == 0 else None)
+        axes.plot(
+          steps,
+          values[:, index],
+          color=colours[index],
+          alpha=1.0 if seed == 0 else OTHER_SEED_ALPHA,
+          linewidth=1.4 if seed == 0 else 0.9,
+          label=f"module {module}" if seed == 0 else None,
+        )
     axes.set_ylabel(label)
     axes.set_ylim(bottom=0)
     axes.grid(alpha=0.3)
   all_axes[0].legend(loc="upper right", fontsize=8, ncols=min(len(modules), 5))
-  all_axes[-1].set_xlabel("control step" + (f" (lines: {len(episodes)} seeds, the first solid)"
-                                            if len(episodes) > 1 else ""))
+  all_axes[-1].set_xlabel(
+    "control step"
+    + (f" (lines: {len(episodes)} seeds, the first solid)" if len(episodes) > 1 else "")
+  )
   if title:
     figure.suptitle(title)
   return _save(figure, path)
 
 
-def forgetting_matrix(matrix: np.ndarray, configurations: Sequence[str],
-                      path: str | pathlib.Path, stage_labels: Sequence[str] | None = None,
-                      title: str = "normalised tip error (%) after each training stage"
-                      ) -> pathlib.Path:
+def forgetting_matrix(
+  matrix: np.ndarray,
+  configurations: Sequence[str],
+  path: str | pathlib.Path,
+  stage_labels: Sequence[str] | None = None,
+  title: str = "normalised tip error (%) after each training stage",
+) -> pathlib.Path:
   """Saves the forgetting heat map: normalised tip error (%) of every configuration (columns)
   after every training stage (rows), each cell labelled; NaN entries (a configuration not yet
   seen) are drawn blank and marked "not seen".
@@ -147,23 +170,30 @@ def forgetting_matrix(matrix: np.ndarray, configurations: Sequence[str],
   """
   matrix = np.asarray(matrix, dtype=float)
   if matrix.ndim != 2 or matrix.shape[0] == 0:
-    raise ValueError(f"forgetting matrix must be (stages, configurations), got shape "
-                     f"{matrix.shape}")
+    raise ValueError(
+      f"forgetting matrix must be (stages, configurations), got shape {matrix.shape}"
+    )
   if matrix.shape[1] != len(configurations):
-    raise ValueError(f"forgetting matrix has {matrix.shape[1]} columns but "
-                     f"{len(configurations)} configurations")
-  stage_labels = (list(stage_labels) if stage_labels is not None
-                  else [f"stage {index + 1}" for index in range(matrix.shape[0])])
+    raise ValueError(
+      f"forgetting matrix has {matrix.shape[1]} columns but {len(configurations)} configurations"
+    )
+  stage_labels = (
+    list(stage_labels)
+    if stage_labels is not None
+    else [f"stage {index + 1}" for index in range(matrix.shape[0])]
+  )
   if len(stage_labels) != matrix.shape[0]:
-    raise ValueError(f"forgetting matrix has {matrix.shape[0]} stages but "
-                     f"{len(stage_labels)} stage labels")
+    raise ValueError(
+      f"forgetting matrix has {matrix.shape[0]} stages but {len(stage_labels)} stage labels"
+    )
   seen = ~np.isnan(matrix)
   if not seen.any():
     raise ValueError("forgetting matrix has no evaluated entry (all NaN)")
   if np.any(np.isinf(matrix)) or np.any(matrix[seen] < 0):
     raise ValueError("forgetting matrix entries must be finite and non-negative, or NaN")
-  figure = Figure(figsize=(1.2 * matrix.shape[1] + 2.8, 0.7 * matrix.shape[0] + 1.6),
-                  layout="constrained")
+  figure = Figure(
+    figsize=(1.2 * matrix.shape[1] + 2.8, 0.7 * matrix.shape[0] + 1.6), layout="constrained"
+  )
   axes = figure.add_subplot()
   colour_map = matplotlib.colormaps[_HEAT_MAP].with_extremes(bad=_NOT_SEEN_COLOUR)
   norm = mpl_colors.Normalize(vmin=0.0, vmax=max(float(matrix[seen].max()), 1e-9))
@@ -173,8 +203,15 @@ def forgetting_matrix(matrix: np.ndarray, configurations: Sequence[str],
       axes.text(column, row, "not seen", ha="center", va="center", fontsize=8, color="0.4")
     else:
       shade = np.mean(colour_map(norm(value))[:3])
-      axes.text(column, row, f"{value:.2f}", ha="center", va="center", fontsize=9,
-                color="black" if shade > 0.5 else "white")
+      axes.text(
+        column,
+        row,
+        f"{value:.2f}",
+        ha="center",
+        va="center",
+        fontsize=9,
+        color="black" if shade > 0.5 else "white",
+      )
   axes.set_xticks(range(matrix.shape[1]), list(configurations))
   axes.set_yticks(range(matrix.shape[0]), stage_labels)
   axes.set_xlabel("configuration evaluated")
@@ -191,14 +228,14 @@ def run_plot_paths(record_path: str | pathlib.Path) -> tuple[pathlib.Path, pathl
   return (stem.with_name(f"{stem.name}-paths.png"), stem.with_name(f"{stem.name}-error.png"))
 
 
-def save_run_plots(record_path: str | pathlib.Path, record: dict,
-                   episodes: Sequence[episodes.Episode]) -> tuple[pathlib.Path, pathlib.Path]:
+def save_run_plots(
+  record_path: str | pathlib.Path, record: dict, episodes: Sequence[episodes.Episode]
+) -> tuple[pathlib.Path, pathlib.Path]:
   """Saves the first episode's (seed 0's) tip paths and every episode's errors over time next to
   the result record ``record`` (``softbench.run``): ``<record stem>-paths.png`` and
   ``<record stem>-error.png``."""
   robot = robots.make(record["robot"])
-  title = (f"{record['agent']} on {record['task']} ({record['robot']}), {record['profile']} "
-           f"profile")
+  title = f"{record['agent']} on {record['task']} ({record['robot']}), {record['profile']} profile"
   paths_png, error_png = run_plot_paths(record_path)
   tracking_paths(episodes[0], paths_png, f"{title}, seed 0", robot)
   tracking_errors(episodes, error_png, title, robot)

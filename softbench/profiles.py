@@ -23,11 +23,11 @@ class Profile:
 
 
 PROFILES = {
-    "paper": Profile("paper", samples=14_000, max_epochs=800, patience=50, seeds=5, compile=True),
-    "default": Profile("default", samples=4_000, max_epochs=30, patience=6, seeds=5,
-                       compile=False),
-    "tiny": Profile("tiny", samples=200, max_epochs=2, patience=2, seeds=2, compile=False,
-                    episode_length=4),
+  "paper": Profile("paper", samples=14_000, max_epochs=800, patience=50, seeds=5, compile=True),
+  "default": Profile("default", samples=4_000, max_epochs=30, patience=6, seeds=5, compile=False),
+  "tiny": Profile(
+    "tiny", samples=200, max_epochs=2, patience=2, seeds=2, compile=False, episode_length=4
+  ),
 }
 DEFAULT_PROFILE = "default"
 

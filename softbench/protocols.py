@@ -13,9 +13,9 @@ alone (``smpl.protocol.train_progressively``); in Exp2S/Exp2R the columns act to
 on module k's own inputs (``smpl.training.train_column_jointly``), as the ``smpl`` agent does.
 """
 
+from collections.abc import Callable
 import contextlib
 import dataclasses
-from collections.abc import Callable
 
 import torch
 
@@ -44,24 +44,33 @@ class Protocol:
     names = tuple(f"{family}-{robots.make(name).num_modules}" for name in self.robot_names)
     if names == self.robot_names:
       return self
-    return dataclasses.replace(self, robot_names=names,
-                               description=f"{self.description}, on the {family} family")
+    return dataclasses.replace(
+      self, robot_names=names, description=f"{self.description}, on the {family} family"
+    )
 
   def column_views(self) -> list[tuple[robots.SoftArm, data.View]]:
     """The robot and data view of each column, in training order."""
     arms = [robots.make(name) for name in self.robot_names]
     if self.per_module:
-      return [(arm, data.View.module(arm, module)) for arm in arms
-              for module in range(1, arm.num_modules + 1)]
+      return [
+        (arm, data.View.module(arm, module))
+        for arm in arms
+        for module in range(1, arm.num_modules + 1)
+      ]
     return [(arm, data.View.end_effector(arm)) for arm in arms]
 
 
 PROTOCOLS = {
-    "exp1s": Protocol("exp1s", tuple(f"tendon-{n}" for n in range(1, 6)), False,
-                      "continual: a new column for each of tendon-1 .. tendon-5"),
-    "exp2s": Protocol("exp2s", ("tendon-3",), True, "distributed: a column per module of tendon-3"),
-    "exp2r": Protocol("exp2r", ("pneumatic-433",), True,
-                      "distributed: a column per module of pneumatic-433"),
+  "exp1s": Protocol(
+    "exp1s",
+    tuple(f"tendon-{n}" for n in range(1, 6)),
+    False,
+    "continual: a new column for each of tendon-1 .. tendon-5",
+  ),
+  "exp2s": Protocol("exp2s", ("tendon-3",), True, "distributed: a column per module of tendon-3"),
+  "exp2r": Protocol(
+    "exp2r", ("pneumatic-433",), True, "distributed: a column per module of pneumatic-433"
+  ),
 }
 
 
@@ -83,21 +92,26 @@ class PreparedColumn:
 
   @property
   def task(self) -> smpl_protocol.ColumnTask:
-    return smpl_protocol.ColumnTask(self.windows.train, self.windows.validation,
-                                    self.windows.test, self.forward_model)
+    return smpl_protocol.ColumnTask(
+      self.windows.train, self.windows.validation, self.windows.test, self.forward_model
+    )
 
 
-def prepare_column(robot: robots.SoftArm, view: data.View, dataset: data.Dataset,
-                   config: training.ForwardTrainingConfig = training.ForwardTrainingConfig(),
-                   device: torch.device | None = None,
-                   on_epoch_end: Callable[[training.EpochReport], None] | None = None
-                   ) -> PreparedColumn:
+def prepare_column(
+  robot: robots.SoftArm,
+  view: data.View,
+  dataset: data.Dataset,
+  config: training.ForwardTrainingConfig = training.ForwardTrainingConfig(),
+  device: torch.device | None = None,
+  on_epoch_end: Callable[[training.EpochReport], None] | None = None,
+) -> PreparedColumn:
   """Cuts ``view``'s windows from ``dataset`` and trains (then freezes) its forward model."""
   windows = data.windows(dataset, view)
   with training.seeded(config.seed, torch.device("cpu")):
     model = smpl_forward.ForwardModel(windows.train.actuation_size, windows.train.pose_size)
-  result = training.train_forward_model(model, windows.train, windows.validation, config, device,
-                                        on_epoch_end)
+  result = training.train_forward_model(
+    model, windows.train, windows.validation, config, device, on_epoch_end
+  )
   return PreparedColumn(robot, windows, model, result)
 
 
@@ -109,17 +123,23 @@ class ProtocolResult:
   run: smpl_protocol.ProgressiveRun
 
 
-ProgressBars = Callable[[str], contextlib.AbstractContextManager[
-    smpl_protocol.EpochCallback | None]]
+ProgressBars = Callable[
+  [str], contextlib.AbstractContextManager[smpl_protocol.EpochCallback | None]
+]
 """Given a label (``forward tendon-2 end-effector``), a context entered around that model's
 training that yields the callback its epochs report to (a progress bar), or None."""
 
 
-def run(protocol: Protocol, samples: int = data.DEFAULT_SAMPLES, seed: int = 0,
-        forward_config: training.ForwardTrainingConfig = training.ForwardTrainingConfig(),
-        inverse_config: training.InverseTrainingConfig = training.InverseTrainingConfig(),
-        device: torch.device | None = None, progress: bool = True,
-        progress_bars: ProgressBars = smpl_protocol.no_progress) -> ProtocolResult:
+def run(
+  protocol: Protocol,
+  samples: int = data.DEFAULT_SAMPLES,
+  seed: int = 0,
+  forward_config: training.ForwardTrainingConfig = training.ForwardTrainingConfig(),
+  inverse_config: training.InverseTrainingConfig = training.InverseTrainingConfig(),
+  device: torch.device | None = None,
+  progress: bool = True,
+  progress_bars: ProgressBars = smpl_protocol.no_progress,
+) -> ProtocolResult:
   """Collects (or finds) each robot's dataset (babbling seed ``seed``), prepares every column,
   then trains the progressive network column by column (``smpl.protocol.train_progressively``,
   or all columns acting together for a per-module protocol). The configs' seeds fix the weights.
@@ -131,41 +151,55 @@ def run(protocol: Protocol, samples: int = data.DEFAULT_SAMPLES, seed: int = 0,
     if arm.name not in datasets:
       datasets[arm.name] = data.collect(arm, samples=samples, seed=seed, progress=progress)
     with progress_bars(f"forward {label}") as on_epoch_end:
-      columns.append(prepare_column(arm, view, datasets[arm.name], forward_config, device,
-                                    on_epoch_end))
+      columns.append(
+        prepare_column(arm, view, datasets[arm.name], forward_config, device, on_epoch_end)
+      )
   stage_bars = lambda stage: progress_bars(f"inverse {labels[stage]}")
   network = progressive.ProgressiveLSTM()
   if protocol.per_module:
     outcome = _train_jointly(network, columns, inverse_config, device, stage_bars)
   else:
-    outcome = smpl_protocol.train_progressively(network, [column.task for column in columns],
-                                                inverse_config, device, stage_bars)
+    outcome = smpl_protocol.train_progressively(
+      network, [column.task for column in columns], inverse_config, device, stage_bars
+    )
   return ProtocolResult(protocol, network, columns, outcome)
 
 
-def _train_jointly(network: progressive.ProgressiveLSTM, columns: list[PreparedColumn],
-                   config: training.InverseTrainingConfig, device: torch.device | None,
-                   stage_progress: smpl_protocol.StageProgress
-                   ) -> smpl_protocol.ProgressiveRun:
+def _train_jointly(
+  network: progressive.ProgressiveLSTM,
+  columns: list[PreparedColumn],
+  config: training.InverseTrainingConfig,
+  device: torch.device | None,
+  stage_progress: smpl_protocol.StageProgress,
+) -> smpl_protocol.ProgressiveRun:
   """Adds and trains one column per module, all columns acting together; scores after each."""
   device = device if device is not None else training.default_device()
   outcome = smpl_protocol.ProgressiveRun(training=[], scores=[])
   for stage, column in enumerate(columns):
-    seen = columns[:stage + 1]
+    seen = columns[: stage + 1]
     split = lambda name: smpl_windows.ModuleWindows(tuple(getattr(c.windows, name) for c in seen))
     train = column.windows.train
     with training.seeded(config.seed + network.num_columns, torch.device("cpu")):
-      network.add_column(smpl_windows.inverse_input_size(train.pose_size, train.action_size),
-                         train.action_size)
+      network.add_column(
+        smpl_windows.inverse_input_size(train.pose_size, train.action_size), train.action_size
+      )
     forwards = [c.forward_model for c in seen]
     with stage_progress(stage) as on_epoch_end:
-      outcome.training.append(training.train_column_jointly(
-          network, forwards, split("train"), split("validation"), config, device, on_epoch_end))
+      outcome.training.append(
+        training.train_column_jointly(
+          network, forwards, split("train"), split("validation"), config, device, on_epoch_end
+        )
+      )
     test = split("test").to(device)
     with torch.no_grad(), training.limited_cpu_threads(config.cpu_threads, device):
       rollouts = smpl_rollout.joint_rollout(network.eval(), test, forwards)
-    outcome.scores.append([smpl_protocol.ColumnScore(
-        torch.nn.functional.mse_loss(result.actions, windows.actions).item(),
-        torch.nn.functional.mse_loss(result.predicted_poses, windows.next_poses).item())
-        for result, windows in zip(rollouts, test.modules)])
+    outcome.scores.append(
+      [
+        smpl_protocol.ColumnScore(
+          torch.nn.functional.mse_loss(result.actions, windows.actions).item(),
+          torch.nn.functional.mse_loss(result.predicted_poses, windows.next_poses).item(),
+        )
+        for result, windows in zip(rollouts, test.modules)
+      ]
+    )
   return outcome

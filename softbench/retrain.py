@@ -35,10 +35,10 @@ DEFAULT_TASK = "spiral"
 DEFAULT_BASELINE = "lstm"
 RETRAINED_AGENT = "smpl"
 CONDITIONS = (
-    ("before", "before the fault (healthy robot)"),
-    ("under", "under the fault, no retraining"),
-    ("retrained", "smpl, column {column} retrained"),
-    ("baseline", "{baseline}, retrained from scratch"),
+  ("before", "before the fault (healthy robot)"),
+  ("under", "under the fault, no retraining"),
+  ("retrained", "smpl, column {column} retrained"),
+  ("baseline", "{baseline}, retrained from scratch"),
 )
 
 
@@ -52,9 +52,15 @@ class RetrainSettings:
     return self.run.faults[0].module
 
 
-def settings(agent: str = RETRAINED_AGENT, robot: str | None = None, faults: tuple[str, ...] = (),
-             profile: str = profiles.DEFAULT_PROFILE, task: str = DEFAULT_TASK,
-             seeds: int | None = None, baseline: str = DEFAULT_BASELINE) -> RetrainSettings:
+def settings(
+  agent: str = RETRAINED_AGENT,
+  robot: str | None = None,
+  faults: tuple[str, ...] = (),
+  profile: str = profiles.DEFAULT_PROFILE,
+  task: str = DEFAULT_TASK,
+  seeds: int | None = None,
+  baseline: str = DEFAULT_BASELINE,
+) -> RetrainSettings:
   """Checked settings; ``faults`` as ``MODULE:ACTUATOR:GAIN`` text, all in one module.
 
   Raises:
@@ -62,12 +68,14 @@ def settings(agent: str = RETRAINED_AGENT, robot: str | None = None, faults: tup
       that is not a centralised learned agent, or anything ``softbench run`` refuses (one line).
   """
   if agent != RETRAINED_AGENT:
-    raise ValueError(f"retrain adapts the {RETRAINED_AGENT} agent (one column per module), "
-                     f"got {agent!r}")
+    raise ValueError(
+      f"retrain adapts the {RETRAINED_AGENT} agent (one column per module), got {agent!r}"
+    )
   if agents.learner(baseline) is None or baseline == RETRAINED_AGENT:
     learners = [name for name in agents.babbling_learners() if name != RETRAINED_AGENT]
-    raise ValueError(f"baseline must be a centralised learned agent ({', '.join(learners)}), "
-                     f"got {baseline!r}")
+    raise ValueError(
+      f"baseline must be a centralised learned agent ({', '.join(learners)}), got {baseline!r}"
+    )
   if not faults:
     raise ValueError(f"retrain needs a fault: --fault {fault_model.FAULT_FORMAT}")
   run = run_module.settings(task, agent, robot, seeds, profile, faults=tuple(faults))
@@ -75,8 +83,9 @@ def settings(agent: str = RETRAINED_AGENT, robot: str | None = None, faults: tup
   return RetrainSettings(run, baseline)
 
 
-def _timed_baseline(settings: RetrainSettings, faulty: robots.SoftArm, seed: int,
-                    show_progress: bool) -> tuple[agents.Agent, float | None, bool]:
+def _timed_baseline(
+  settings: RetrainSettings, faulty: robots.SoftArm, seed: int, show_progress: bool
+) -> tuple[agents.Agent, float | None, bool]:
   """The baseline trained on the faulty robot, the wall time of its training and whether it was
   trained now (the checkpoint did not exist, or was damaged and written again)."""
   profile = settings.run.profile
@@ -109,18 +118,21 @@ def _seed(settings: RetrainSettings, seed: int, show_progress: bool) -> dict:
   before, scored = run_module.evaluate(smpl, healthy, run, seed, show_progress)
   under, _ = run_module.evaluate(smpl, faulty, run, seed, show_progress)
   retrained = adaptation.retrain_column(smpl, faulty, run.profile, show_progress)
-  identical = adaptation.columns_bit_identical(smpl.inverse, retrained.agent.inverse,
-                                               retrained.column)
+  identical = adaptation.columns_bit_identical(
+    smpl.inverse, retrained.agent.inverse, retrained.column
+  )
   after, _ = run_module.evaluate(retrained.agent, faulty, run, seed, show_progress)
   baseline, baseline_seconds, baseline_now = _timed_baseline(settings, faulty, seed, show_progress)
   from_scratch, _ = run_module.evaluate(baseline, faulty, run, seed, show_progress)
-  return {"scores": {"before": before, "under": under, "retrained": after,
-                     "baseline": from_scratch},
-          "retraining": {"retrained": {"wall_time_s": retrained.wall_time_s,
-                                       "trained_now": retrained.trained_now},
-                         "baseline": {"wall_time_s": baseline_seconds,
-                                      "trained_now": baseline_now}},
-          "other_columns_bit_identical": identical, "scored_modules": scored}
+  return {
+    "scores": {"before": before, "under": under, "retrained": after, "baseline": from_scratch},
+    "retraining": {
+      "retrained": {"wall_time_s": retrained.wall_time_s, "trained_now": retrained.trained_now},
+      "baseline": {"wall_time_s": baseline_seconds, "trained_now": baseline_now},
+    },
+    "other_columns_bit_identical": identical,
+    "scored_modules": scored,
+  }
 
 
 def execute(settings: RetrainSettings, show_progress: bool = True) -> dict:
@@ -131,37 +143,50 @@ def execute(settings: RetrainSettings, show_progress: bool = True) -> dict:
   run = settings.run
   healthy = robots.make(run.robot)
   faulty = healthy.with_faults(run.faults)
-  data.collect(healthy, samples=run.profile.samples, seed=learned.DATA_SEED,
-               progress=show_progress)
-  faulty_data = data.collect(faulty, samples=run.profile.samples, seed=learned.DATA_SEED,
-                             progress=show_progress)
+  data.collect(healthy, samples=run.profile.samples, seed=learned.DATA_SEED, progress=show_progress)
+  faulty_data = data.collect(
+    faulty, samples=run.profile.samples, seed=learned.DATA_SEED, progress=show_progress
+  )
   seeds = [_seed(settings, seed, show_progress) for seed in range(run.seeds)]
   module = settings.module
   record = {
-      "format": run_module.RECORD_FORMAT, "version": run_module.RECORD_VERSION, **origin,
-      "robot": run.robot, "task": run.task, "agent": RETRAINED_AGENT, "profile": run.profile.name,
-      "profile_settings": dataclasses.asdict(run.profile), "eval_mode": run.eval_mode,
-      "trajectory": None, "seeds": run.seeds,
-      "faults": [fault_model.describe(healthy, fault) for fault in run.faults],
-      "scored_modules": list(seeds[0]["scored_modules"]),
-      "per_seed": [entry["scores"]["retrained"] for entry in seeds],
-      "fault": {
-          "module": module, "retrained_column": module,
-          "retrained_forward_models": list(range(module, healthy.num_modules + 1)),
-          "baseline": settings.baseline,
-          "faulty_babbling": {"samples": faulty_data.samples,
-                              "collection_wall_time_s": faulty_data.collection.get("wall_time_s")},
-          "other_columns_bit_identical": all(entry["other_columns_bit_identical"]
-                                             for entry in seeds),
-          "conditions": {name: {"per_seed": [entry["scores"][name] for entry in seeds]}
-                         for name, _ in CONDITIONS},
-          "retraining_wall_time_s": {
-              name: [entry["retraining"][name]["wall_time_s"] for entry in seeds]
-              for name in ("retrained", "baseline")},
-          "trained_now": {name: [entry["retraining"][name]["trained_now"] for entry in seeds]
-                          for name in ("retrained", "baseline")},
+    "format": run_module.RECORD_FORMAT,
+    "version": run_module.RECORD_VERSION,
+    **origin,
+    "robot": run.robot,
+    "task": run.task,
+    "agent": RETRAINED_AGENT,
+    "profile": run.profile.name,
+    "profile_settings": dataclasses.asdict(run.profile),
+    "eval_mode": run.eval_mode,
+    "trajectory": None,
+    "seeds": run.seeds,
+    "faults": [fault_model.describe(healthy, fault) for fault in run.faults],
+    "scored_modules": list(seeds[0]["scored_modules"]),
+    "per_seed": [entry["scores"]["retrained"] for entry in seeds],
+    "fault": {
+      "module": module,
+      "retrained_column": module,
+      "retrained_forward_models": list(range(module, healthy.num_modules + 1)),
+      "baseline": settings.baseline,
+      "faulty_babbling": {
+        "samples": faulty_data.samples,
+        "collection_wall_time_s": faulty_data.collection.get("wall_time_s"),
       },
-      "wall_time_s": round(time.perf_counter() - started, 3),
+      "other_columns_bit_identical": all(entry["other_columns_bit_identical"] for entry in seeds),
+      "conditions": {
+        name: {"per_seed": [entry["scores"][name] for entry in seeds]} for name, _ in CONDITIONS
+      },
+      "retraining_wall_time_s": {
+        name: [entry["retraining"][name]["wall_time_s"] for entry in seeds]
+        for name in ("retrained", "baseline")
+      },
+      "trained_now": {
+        name: [entry["retraining"][name]["trained_now"] for entry in seeds]
+        for name in ("retrained", "baseline")
+      },
+    },
+    "wall_time_s": round(time.perf_counter() - started, 3),
   }
   return record
 
@@ -177,13 +202,17 @@ def table(record: dict) -> str:
   """Rows per condition, columns per metric (module mean, mean ± std over seeds), and the wall
   time of each retraining."""
   fault = record["fault"]
-  measured = [(name, label) for name, label in run_module.METRICS
-              if name in fault["conditions"]["before"]["per_seed"][0]]
+  measured = [
+    (name, label)
+    for name, label in run_module.METRICS
+    if name in fault["conditions"]["before"]["per_seed"][0]
+  ]
   faults = ", ".join(f"{f['text']} ({f['actuator_name']})" for f in record["faults"])
-  lines = [f"{record['agent']} on {record['task']} ({record['robot']}), fault {faults}, profile "
-           f"{record['profile']}, {record['seeds']} seed(s): module mean, mean ± std over seeds",
-           f"{'':<36}" + "".join(f"{label:>22}" for _, label in measured)
-           + f"{'retraining (s)':>22}"]
+  lines = [
+    f"{record['agent']} on {record['task']} ({record['robot']}), fault {faults}, profile "
+    f"{record['profile']}, {record['seeds']} seed(s): module mean, mean ± std over seeds",
+    f"{'':<36}" + "".join(f"{label:>22}" for _, label in measured) + f"{'retraining (s)':>22}",
+  ]
   for name, label in CONDITIONS:
     entries = fault["conditions"][name]["per_seed"]
     cells = []
@@ -192,14 +221,19 @@ def table(record: dict) -> str:
       cells.append(f"{statistic.mean:>13.2f} ± {statistic.std:<6.2f}")
     timing = fault["retraining_wall_time_s"].get(name)
     cells.append(_cell(timing) if timing is not None else "")
-    lines.append(f"{label.format(column=fault['module'], baseline=fault['baseline']):<36}"
-                 + "".join(cells))
+    lines.append(
+      f"{label.format(column=fault['module'], baseline=fault['baseline']):<36}" + "".join(cells)
+    )
   babbling = fault["faulty_babbling"]
   seconds = babbling["collection_wall_time_s"]
-  lines.append(f"babbling of the faulty robot: {babbling['samples']} samples"
-               + (f", collected in {seconds:.1f} s" if seconds is not None else ""))
-  lines.append("other columns bit-identical after retraining: "
-               + ("yes" if fault["other_columns_bit_identical"] else "NO"))
+  lines.append(
+    f"babbling of the faulty robot: {babbling['samples']} samples"
+    + (f", collected in {seconds:.1f} s" if seconds is not None else "")
+  )
+  lines.append(
+    "other columns bit-identical after retraining: "
+    + ("yes" if fault["other_columns_bit_identical"] else "NO")
+  )
   lines.append(f"wall time {record['wall_time_s']:.1f} s")
   return "\n".join(lines)
 

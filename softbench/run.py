@@ -38,8 +38,11 @@ from softbench.robots import faults as fault_model
 from softbench.suite import reach
 from softbench.suite import trajectories
 
-METRICS = (("position_mm", "position (mm)"), ("orientation_deg", "orientation (deg)"),
-           ("normalised_tip_percent", "tip error (%)"))
+METRICS = (
+  ("position_mm", "position (mm)"),
+  ("orientation_deg", "orientation (deg)"),
+  ("normalised_tip_percent", "tip error (%)"),
+)
 RECORD_FORMAT = records.FORMAT
 RECORD_VERSION = records.VERSION
 
@@ -60,11 +63,20 @@ class RunSettings:
   faults: tuple[fault_model.Fault, ...] = ()
 
 
-def settings(task: str, agent: str, robot: str | None = None, seeds: int | None = None,
-             profile: str = profiles.DEFAULT_PROFILE, eval_mode: str = "physics",
-             trajectory: str | None = None, module: int | None = None, adaptive: bool = False,
-             targets: int | None = None, helpers: str | None = None,
-             faults: tuple[str, ...] = ()) -> RunSettings:
+def settings(
+  task: str,
+  agent: str,
+  robot: str | None = None,
+  seeds: int | None = None,
+  profile: str = profiles.DEFAULT_PROFILE,
+  eval_mode: str = "physics",
+  trajectory: str | None = None,
+  module: int | None = None,
+  adaptive: bool = False,
+  targets: int | None = None,
+  helpers: str | None = None,
+  faults: tuple[str, ...] = (),
+) -> RunSettings:
   """Checked settings, with the defaults filled in; ``faults`` as ``MODULE:ACTUATOR:GAIN`` text.
 
   Raises:
@@ -87,8 +99,9 @@ def settings(task: str, agent: str, robot: str | None = None, seeds: int | None 
   seeds = (1 if adaptive else chosen.seeds) if seeds is None else seeds
   dataset.check_count("seeds", seeds)
   if eval_mode not in learned.ERROR_SOURCES:
-    raise ValueError(f"unknown eval mode {eval_mode!r}; choose one of "
-                     f"{', '.join(learned.ERROR_SOURCES)}")
+    raise ValueError(
+      f"unknown eval mode {eval_mode!r}; choose one of {', '.join(learned.ERROR_SOURCES)}"
+    )
   if (trajectory is None) == (task == "custom"):
     raise ValueError("--trajectory goes with --task custom, and --task custom needs one")
   if trajectory is not None:  # Read now: a bad file is refused before any collection or training.
@@ -96,13 +109,32 @@ def settings(task: str, agent: str, robot: str | None = None, seeds: int | None 
   if adaptive:
     targets = adaptive_activation.DEFAULT_TARGETS if targets is None else targets
     helpers = adaptive_activation.experiment.DEFAULT_HELPERS if helpers is None else helpers
-  return RunSettings(task, agent, robot, seeds, chosen, eval_mode,
-                     None if trajectory is None else str(trajectory), module, adaptive, targets,
-                     helpers, parsed_faults)
+  return RunSettings(
+    task,
+    agent,
+    robot,
+    seeds,
+    chosen,
+    eval_mode,
+    None if trajectory is None else str(trajectory),
+    module,
+    adaptive,
+    targets,
+    helpers,
+    parsed_faults,
+  )
 
 
-def _check_adaptive(task: str, agent: str, robot: str, seeds: int | None, module: int | None,
-                    adaptive: bool, targets: int | None, helpers: str | None) -> None:
+def _check_adaptive(
+  task: str,
+  agent: str,
+  robot: str,
+  seeds: int | None,
+  module: int | None,
+  adaptive: bool,
+  targets: int | None,
+  helpers: str | None,
+) -> None:
   """The checks of ``--module``, ``--adaptive``, ``--targets`` and ``--helpers``."""
   if module is not None and task != "reach":
     raise ValueError("--module goes with --task reach")
@@ -111,8 +143,10 @@ def _check_adaptive(task: str, agent: str, robot: str, seeds: int | None, module
   if adaptive and task != "reach":
     raise ValueError(f"--adaptive goes with --task reach, not {task!r}: it reaches a point")
   if adaptive and agents.learner(agent) is None:
-    raise ValueError(f"--adaptive needs an agent trained on babbling "
-                     f"({', '.join(agents.babbling_learners())}), not {agent!r}")
+    raise ValueError(
+      f"--adaptive needs an agent trained on babbling "
+      f"({', '.join(agents.babbling_learners())}), not {agent!r}"
+    )
   if adaptive and seeds not in (None, 1):
     raise ValueError("--adaptive uses one trained agent (seed 0); vary --targets, not --seeds")
   if (targets is not None or helpers is not None) and not adaptive:
@@ -134,9 +168,14 @@ def task_options(run: RunSettings) -> dict:
 def replay_of(run: RunSettings, seed: int, episode: episodes.Episode) -> replay.Replay:
   """The replay of ``episode``, seed ``seed`` of ``run``, for videos."""
   feedback = "" if run.eval_mode == "physics" else f", eval {run.eval_mode}"
-  return replay.Replay(robots.make(run.robot), run.task, seed, task_options(run), episode,
-                       f"{run.agent} on {run.task} ({run.robot}) seed {seed}, "
-                       f"{run.profile.name} profile{feedback}")
+  return replay.Replay(
+    robots.make(run.robot),
+    run.task,
+    seed,
+    task_options(run),
+    episode,
+    f"{run.agent} on {run.task} ({run.robot}) seed {seed}, {run.profile.name} profile{feedback}",
+  )
 
 
 def _seed_scores(score: metrics.TrackingScore) -> dict:
@@ -145,14 +184,17 @@ def _seed_scores(score: metrics.TrackingScore) -> dict:
   for name, _ in METRICS:
     per_module = getattr(score, name)
     if per_module:
-      result[name] = {"per_module": [s.mean for s in per_module],
-                      "per_module_std_over_steps": [s.std for s in per_module],
-                      "mean": score.average(name).mean}
+      result[name] = {
+        "per_module": [s.mean for s in per_module],
+        "per_module_std_over_steps": [s.std for s in per_module],
+        "mean": score.average(name).mean,
+      }
   return result
 
 
-def episode_on(agent: agents.Agent, arm: robots.SoftArm, run: RunSettings, seed: int,
-               show_progress: bool = False) -> episodes.Episode:
+def episode_on(
+  agent: agents.Agent, arm: robots.SoftArm, run: RunSettings, seed: int, show_progress: bool = False
+) -> episodes.Episode:
   """One episode of ``run``'s task (environment seed ``seed``) by ``agent`` on ``arm``, which may
   be a faulty robot."""
   if isinstance(agent, learned.LearnedAgent):
@@ -163,13 +205,17 @@ def episode_on(agent: agents.Agent, arm: robots.SoftArm, run: RunSettings, seed:
 
 def seed_entry(seed: int, episode: episodes.Episode, arm: robots.SoftArm) -> dict:
   """The record's entry of one seed's episode."""
-  return {"seed": seed, "steps": len(episode.actions),
-          "mean_reward": float(episode.rewards.mean()),
-          **_seed_scores(episode.score(arm.length))}
+  return {
+    "seed": seed,
+    "steps": len(episode.actions),
+    "mean_reward": float(episode.rewards.mean()),
+    **_seed_scores(episode.score(arm.length)),
+  }
 
 
-def evaluate(agent: agents.Agent, arm: robots.SoftArm, run: RunSettings, seed: int,
-             show_progress: bool = False) -> tuple[dict, tuple[int, ...]]:
+def evaluate(
+  agent: agents.Agent, arm: robots.SoftArm, run: RunSettings, seed: int, show_progress: bool = False
+) -> tuple[dict, tuple[int, ...]]:
   """``episode_on``, scored: the seed's record entry and the scored modules."""
   episode = episode_on(agent, arm, run, seed, show_progress)
   return seed_entry(seed, episode, arm), episode.scored_modules
@@ -181,8 +227,9 @@ def seed_episode(run: RunSettings, seed: int, show_progress: bool = False) -> ep
   return _episode_and_arm(run, seed, show_progress)[0]
 
 
-def _episode_and_arm(run: RunSettings, seed: int, show_progress: bool
-                     ) -> tuple[episodes.Episode, robots.SoftArm]:
+def _episode_and_arm(
+  run: RunSettings, seed: int, show_progress: bool
+) -> tuple[episodes.Episode, robots.SoftArm]:
   """``seed_episode``, and the (faulty) robot it ran on."""
   arm = robots.make(run.robot)
   agent = agents.make(run.agent, arm, seed, run.profile, show_progress)
@@ -196,8 +243,7 @@ def score_seed(run: RunSettings, seed: int) -> dict:
   return seed_entry(seed, episode, arm)
 
 
-def _run_seed(seed: int, run: RunSettings,
-              show_progress: bool) -> tuple[dict, episodes.Episode]:
+def _run_seed(seed: int, run: RunSettings, show_progress: bool) -> tuple[dict, episodes.Episode]:
   """The episode of ``seed`` (``seed_episode``, or the one an interrupted run of the same
   settings and code saved) and its record entry; a new episode is saved at once."""
   episode = episode_snapshots.load(run, seed)
@@ -218,8 +264,9 @@ def execute(run: RunSettings, show_progress: bool = True, workers: int | None = 
   return execute_episodes(run, show_progress, workers)[0]
 
 
-def execute_episodes(run: RunSettings, show_progress: bool = True, workers: int | None = None,
-                     keep_seeds: bool = False) -> tuple[dict, list[episodes.Episode]]:
+def execute_episodes(
+  run: RunSettings, show_progress: bool = True, workers: int | None = None, keep_seeds: bool = False
+) -> tuple[dict, list[episodes.Episode]]:
   """``execute``, also returning every seed's episode (in seed order) for plots and videos;
   a learned agent's checkpoints that the data home lacks are taken from the zoo where it holds
   them (``softbench.zoo``; the record then names them in a ``zoo`` section), and the babbling
@@ -233,41 +280,67 @@ def execute_episodes(run: RunSettings, show_progress: bool = True, workers: int 
   taken = []
   learner = agents.learner(run.agent)
   if learner is not None:
-    taken, trained = zoo.take([learned.checkpoint_path(run.agent, arm, seed, run.profile,
-                                                       learner.per_module)
-                               for seed in range(run.seeds)])
+    taken, trained = zoo.take(
+      [
+        learned.checkpoint_path(run.agent, arm, seed, run.profile, learner.per_module)
+        for seed in range(run.seeds)
+      ]
+    )
     if not trained:
-      data.collect(run.robot, samples=run.profile.samples, seed=learned.DATA_SEED,
-                   progress=show_progress)
+      data.collect(
+        run.robot, samples=run.profile.samples, seed=learned.DATA_SEED, progress=show_progress
+      )
   elif agents.describe(run.agent).learned:  # It learns by acting, on the babbling targets (sac).
-    data.collect(run.robot, samples=run.profile.samples, seed=learned.DATA_SEED,
-                 progress=show_progress)
+    data.collect(
+      run.robot, samples=run.profile.samples, seed=learned.DATA_SEED, progress=show_progress
+    )
   if run.adaptive:
-    section = adaptive_activation.run(run.robot, run.agent, run.profile, run.targets,
-                                      run.module, run.eval_mode, run.helpers, show_progress)
-    results = {"scored_modules": [section["target_module"]], "per_seed": [],
-               "adaptive": section}
+    section = adaptive_activation.run(
+      run.robot,
+      run.agent,
+      run.profile,
+      run.targets,
+      run.module,
+      run.eval_mode,
+      run.helpers,
+      show_progress,
+    )
+    results = {"scored_modules": [section["target_module"]], "per_seed": [], "adaptive": section}
   else:
     if show_progress:
       episode_snapshots.report_resuming(episode_snapshots.folder(run), run.seeds)
-    outcomes = parallel_seeds.over_seeds(_run_seed, run.seeds, (run,), f"{run.agent} on {run.task}",
-                          show_progress, workers)
+    outcomes = parallel_seeds.over_seeds(
+      _run_seed, run.seeds, (run,), f"{run.agent} on {run.task}", show_progress, workers
+    )
     if not keep_seeds:
       episode_snapshots.discard(run)
-    results = {"scored_modules": list(outcomes[0][1].scored_modules),
-               "per_seed": [entry for entry, _ in outcomes]}
-    spent = [agents.training_summary(run.agent, arm, seed, run.profile)
-             for seed in range(run.seeds)]
+    results = {
+      "scored_modules": list(outcomes[0][1].scored_modules),
+      "per_seed": [entry for entry, _ in outcomes],
+    }
+    spent = [
+      agents.training_summary(run.agent, arm, seed, run.profile) for seed in range(run.seeds)
+    ]
     if any(summary is not None for summary in spent):  # An agent that learns by acting.
-      results["training"] = {"per_seed": [{"seed": seed, **(summary or {})}
-                                          for seed, summary in enumerate(spent)]}
+      results["training"] = {
+        "per_seed": [{"seed": seed, **(summary or {})} for seed, summary in enumerate(spent)]
+      }
   record = {
-      "format": RECORD_FORMAT, "version": RECORD_VERSION, **origin,
-      "robot": run.robot, "task": run.task, "agent": run.agent, "profile": run.profile.name,
-      "profile_settings": dataclasses.asdict(run.profile), "eval_mode": run.eval_mode,
-      "trajectory": run.trajectory, "seeds": run.seeds,
-      "faults": [fault_model.describe(arm, fault) for fault in run.faults], **results,
-      **zoo.section(taken), "wall_time_s": round(time.perf_counter() - started, 3),
+    "format": RECORD_FORMAT,
+    "version": RECORD_VERSION,
+    **origin,
+    "robot": run.robot,
+    "task": run.task,
+    "agent": run.agent,
+    "profile": run.profile.name,
+    "profile_settings": dataclasses.asdict(run.profile),
+    "eval_mode": run.eval_mode,
+    "trajectory": run.trajectory,
+    "seeds": run.seeds,
+    "faults": [fault_model.describe(arm, fault) for fault in run.faults],
+    **results,
+    **zoo.section(taken),
+    "wall_time_s": round(time.perf_counter() - started, 3),
   }
   return record, [] if run.adaptive else [episode for _, episode in outcomes]
 
@@ -275,8 +348,10 @@ def execute_episodes(run: RunSettings, show_progress: bool = True, workers: int 
 def summary(record: dict, metric: str) -> tuple[list[metrics.Statistic], metrics.Statistic]:
   """Per-module and module-averaged mean and standard deviation over seeds of ``metric``."""
   seeds = [entry[metric] for entry in record["per_seed"] if metric in entry]
-  per_module = [metrics.Statistic.of([entry["per_module"][k] for entry in seeds])
-                for k in range(len(seeds[0]["per_module"]))]
+  per_module = [
+    metrics.Statistic.of([entry["per_module"][k] for entry in seeds])
+    for k in range(len(seeds[0]["per_module"]))
+  ]
   return per_module, metrics.Statistic.of([entry["mean"] for entry in seeds])
 
 
@@ -291,9 +366,12 @@ def table(record: dict) -> str:
   header = f"{'':<10}" + "".join(f"{label:>22}" for _, label in measured)
   faulty = record.get("faults") or []
   under = f" under fault {', '.join(fault['text'] for fault in faulty)}" if faulty else ""
-  lines = [f"{record['agent']} on {record['task']} ({record['robot']}{under}), profile "
-           f"{record['profile']}, eval {record['eval_mode']}, {record['seeds']} seed(s): "
-           f"mean ± std over seeds", header]
+  lines = [
+    f"{record['agent']} on {record['task']} ({record['robot']}{under}), profile "
+    f"{record['profile']}, eval {record['eval_mode']}, {record['seeds']} seed(s): "
+    f"mean ± std over seeds",
+    header,
+  ]
   for index, row in enumerate(rows):
     cells = []
     for name, _ in measured:
@@ -307,7 +385,11 @@ def table(record: dict) -> str:
 
 def record_path(record: dict, results: pathlib.Path) -> pathlib.Path:
   task = record["task"] + ("-adaptive" if "adaptive" in record else "")
-  faulty = "".join(f"-fault{fault['module']}.{fault['actuator']}.{fault['gain']:g}"
-                   for fault in record.get("faults") or [])
-  return results / (f"{record['agent']}-{record['robot']}{faulty}-{task}-{record['profile']}-"
-                    f"{record['eval_mode']}-{provenance.date_stamp(record)}.json")
+  faulty = "".join(
+    f"-fault{fault['module']}.{fault['actuator']}.{fault['gain']:g}"
+    for fault in record.get("faults") or []
+  )
+  return results / (
+    f"{record['agent']}-{record['robot']}{faulty}-{task}-{record['profile']}-"
+    f"{record['eval_mode']}-{provenance.date_stamp(record)}.json"
+  )

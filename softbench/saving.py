@@ -23,8 +23,9 @@ class Runner(Protocol):
   def record_path(self, record: dict, results: pathlib.Path) -> pathlib.Path: ...
 
 
-def save(runner: Runner, record: dict, results: pathlib.Path,
-         copy: pathlib.Path | None = None) -> list[pathlib.Path]:
+def save(
+  runner: Runner, record: dict, results: pathlib.Path, copy: pathlib.Path | None = None
+) -> list[pathlib.Path]:
   """Prints ``runner``'s table of ``record``, writes it under ``results`` (and to ``copy``);
   returns the files written, the results folder's first."""
   print(runner.table(record))

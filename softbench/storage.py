@@ -14,7 +14,9 @@ import tempfile
 import numpy as np
 
 from smpl import files
-from smpl.files import CorruptFileWarning, first_line, read_cached  # noqa: F401
+from smpl.files import CorruptFileWarning  # noqa: F401
+from smpl.files import first_line  # noqa: F401
+from smpl.files import read_cached  # noqa: F401
 from smpl.files import write_cache_file  # noqa: F401  (softbench's caches write through it)
 
 HOME_VARIABLE = "SOFTBENCH_HOME"
@@ -47,24 +49,28 @@ def check_writable(path: str | os.PathLike, what: str, folder: bool = False) -> 
   """
   path = pathlib.Path(path)
   if path.exists() and path.is_dir() != folder:
-    raise ValueError(f"cannot write {what} {str(path)!r}: it is "
-                     f"{'a file' if folder else 'a folder'}")
+    raise ValueError(
+      f"cannot write {what} {str(path)!r}: it is {'a file' if folder else 'a folder'}"
+    )
   ancestor = path.absolute() if folder else path.absolute().parent
   while not ancestor.exists():
     ancestor = ancestor.parent
   if not ancestor.is_dir():
     raise ValueError(f"cannot write {what} {str(path)!r}: {str(ancestor)!r} is not a folder")
   if not os.access(ancestor, os.W_OK | os.X_OK):
-    raise ValueError(f"cannot write {what} {str(path)!r}: no permission to write in "
-                     f"{str(ancestor)!r}")
+    raise ValueError(
+      f"cannot write {what} {str(path)!r}: no permission to write in {str(ancestor)!r}"
+    )
   if not folder and path.exists() and not os.access(path, os.W_OK):
     raise ValueError(f"cannot write {what} {str(path)!r}: the file is read-only")
   try:  # The permission bits do not tell a read-only mount or /proc (nor anything to root).
     with tempfile.TemporaryFile(dir=ancestor):
       pass
   except OSError as error:
-    raise ValueError(f"cannot write {what} {str(path)!r}: {str(ancestor)!r} takes no new file "
-                     f"({error.strerror or first_line(error)})") from None
+    raise ValueError(
+      f"cannot write {what} {str(path)!r}: {str(ancestor)!r} takes no new file "
+      f"({error.strerror or first_line(error)})"
+    ) from None
   return path
 
 

@@ -10,7 +10,6 @@ import pytest
 
 from smpl import snapshots
 from smpl import training
-
 from softbench import continual
 from softbench import data
 from softbench import leaderboard
@@ -64,6 +63,7 @@ def two_stages(monkeypatch, tmp_path):
 def assert_regenerates_identically():
   """Checks that the pages of a results folder come out byte-identical when written again and
   when the folder (its records written in another order) is moved elsewhere."""
+
   def check(results, tmp_path):
     first = leaderboard.write(leaderboard.build(results), results, tmp_path / "site")
     contents = [path.read_bytes() for path in first]
@@ -73,8 +73,9 @@ def assert_regenerates_identically():
     (moved / "results").mkdir(parents=True)
     for path in sorted(results.glob("*.json"), reverse=True):
       (moved / "results" / path.name).write_bytes(path.read_bytes())
-    again = leaderboard.write(leaderboard.build(moved / "results"), moved / "results",
-                              moved / "site")
+    again = leaderboard.write(
+      leaderboard.build(moved / "results"), moved / "results", moved / "site"
+    )
     assert [path.read_bytes() for path in again] == contents
 
   return check
@@ -84,6 +85,7 @@ def assert_regenerates_identically():
 def assert_one_line_retraining():
   """Checks that caught warnings hold one ``data.CorruptFileWarning``: one line naming the damaged
   file and saying that it is trained again."""
+
   def check(caught, path):
     (warning,) = [entry for entry in caught if issubclass(entry.category, data.CorruptFileWarning)]
     message = str(warning.message)
@@ -102,11 +104,19 @@ def broken_egl_environment():
 @pytest.fixture
 def launch_with_broken_egl(broken_egl_environment):
   """Runs ``softbench ARGV`` in a child with MUJOCO_GL unset and an EGL that cannot open."""
+
   def launch(argv: list[str]) -> subprocess.CompletedProcess:
-    inherited = {name: value for name, value in os.environ.items()
-                 if name not in ("MUJOCO_GL", "PYOPENGL_PLATFORM")}
-    return subprocess.run([sys.executable, "-m", "softbench.launcher", *argv],
-                          env={**inherited, **broken_egl_environment}, capture_output=True,
-                          text=True, timeout=300)
+    inherited = {
+      name: value
+      for name, value in os.environ.items()
+      if name not in ("MUJOCO_GL", "PYOPENGL_PLATFORM")
+    }
+    return subprocess.run(
+      [sys.executable, "-m", "softbench.launcher", *argv],
+      env={**inherited, **broken_egl_environment},
+      capture_output=True,
+      text=True,
+      timeout=300,
+    )
 
   return launch

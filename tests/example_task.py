@@ -11,8 +11,9 @@ HOLD_STEPS = 20  # Control steps per episode.
 class Hold(base.SoftArmTask):
   """Keep every module's pose where the random start left it."""
 
-  def __init__(self, robot, steps: int = HOLD_STEPS, initial_actuation=base.INITIAL_ACTUATION,
-               random=None):
+  def __init__(
+    self, robot, steps: int = HOLD_STEPS, initial_actuation=base.INITIAL_ACTUATION, random=None
+  ):
     super().__init__(robot, initial_actuation, random)
     self._steps, self._start = steps, None
 

@@ -39,24 +39,33 @@ def summary(staged: procedure.ActivationProcedure):
 
 
 class TestProcedure:
-
   def test_target_alone_then_preceding_then_following(self):
     staged = drive({(2,): 10.0, (1, 2): 6.0, (1, 2, 3): 4.0})
-    assert summary(staged) == [("target", (2,), None), ("preceding", (1, 2), True),
-                               ("following", (1, 2, 3), True)]
+    assert summary(staged) == [
+      ("target", (2,), None),
+      ("preceding", (1, 2), True),
+      ("following", (1, 2, 3), True),
+    ]
     assert staged.done and staged.active == (1, 2, 3) and staged.final_error == 4.0
 
   def test_a_module_that_raises_the_error_is_switched_off_again(self):
     staged = drive({(2,): 10.0, (1, 2): 6.0, (1, 2, 3): 7.0})
-    assert summary(staged) == [("target", (2,), None), ("preceding", (1, 2), True),
-                               ("following", (1, 2, 3), False), ("revert", (1, 2), None)]
+    assert summary(staged) == [
+      ("target", (2,), None),
+      ("preceding", (1, 2), True),
+      ("following", (1, 2, 3), False),
+      ("revert", (1, 2), None),
+    ]
     assert staged.active == (1, 2)
     assert staged.final_error == 6.0  # The revert stage's own error (here the same as before).
 
   def test_equal_error_is_not_better(self):
     staged = drive({(2,): 10.0, (1, 2): 10.0, (2, 3): 3.0})
-    assert summary(staged) == [("target", (2,), None), ("preceding", (1, 2), False),
-                               ("following", (2, 3), True)]
+    assert summary(staged) == [
+      ("target", (2,), None),
+      ("preceding", (1, 2), False),
+      ("following", (2, 3), True),
+    ]
     assert staged.active == (2, 3) and staged.final_error == 3.0
 
   def test_stops_as_soon_as_the_error_is_within_the_threshold(self):
@@ -76,15 +85,22 @@ class TestProcedure:
     assert procedure.candidates(5, 3) == (2, 4, 1, 5)
     assert procedure.candidates(1, 1) == ()
     assert procedure.ActivationProcedure(3, 2, 1.0).labels == (
-        "module 2 alone", "+ module 1", "+ module 3", "back to the kept modules")
+      "module 2 alone",
+      "+ module 1",
+      "+ module 3",
+      "back to the kept modules",
+    )
     assert procedure.ActivationProcedure(3, 2, 1.0).max_stages == 4
 
-  @pytest.mark.parametrize("arguments,message", [
+  @pytest.mark.parametrize(
+    "arguments,message",
+    [
       ((3, 4, 1.0), "target module must be 1 to 3"),
       ((0, 1, 1.0), "num_modules must be"),
       ((3, 2, -1.0), "threshold must be"),
       ((3, 2, float("nan")), "threshold must be"),
-  ])
+    ],
+  )
   def test_refuses_bad_settings(self, arguments, message):
     with pytest.raises(ValueError, match=message):
       procedure.ActivationProcedure(*arguments)
@@ -111,7 +127,6 @@ def reach_actions(agent, active=None, helpers="hold", seed=0):
 
 @pytest.mark.parametrize("agent_name", agents.babbling_learners())
 class TestMasking:
-
   def test_inactive_modules_get_exactly_zero(self, agent_name):
     agent = agents.make(agent_name, ROBOT, 0, "tiny")
     all_on = reach_actions(agent)
@@ -120,16 +135,19 @@ class TestMasking:
       assert np.all(masked[:, list(MODULE_ENTRIES[1]) + list(MODULE_ENTRIES[3])] == 0.0)
       assert np.all(np.any(masked[:, list(MODULE_ENTRIES[2])] != 0.0, axis=1))
     # The first step's inputs do not depend on the mask (no error, no previous action yet).
-    np.testing.assert_array_equal(reach_actions(agent, (2,))[0, list(MODULE_ENTRIES[2])],
-                                  all_on[0, list(MODULE_ENTRIES[2])])
+    np.testing.assert_array_equal(
+      reach_actions(agent, (2,))[0, list(MODULE_ENTRIES[2])], all_on[0, list(MODULE_ENTRIES[2])]
+    )
 
   def test_every_module_active_is_the_unmasked_agent_bit_for_bit(self, agent_name):
     agent = agents.make(agent_name, ROBOT, 0, "tiny")
     for helpers in learned.HELPER_TARGETS:
-      np.testing.assert_array_equal(reach_actions(agent, (1, 2, 3), helpers),
-                                    reach_actions(agent, None, helpers))
-    np.testing.assert_array_equal(reach_actions(agent), reach_actions(agents.make(
-        agent_name, ROBOT, 0, "tiny")))
+      np.testing.assert_array_equal(
+        reach_actions(agent, (1, 2, 3), helpers), reach_actions(agent, None, helpers)
+      )
+    np.testing.assert_array_equal(
+      reach_actions(agent), reach_actions(agents.make(agent_name, ROBOT, 0, "tiny"))
+    )
 
   def test_refuses_modules_the_robot_lacks(self, agent_name):
     agent = agents.make(agent_name, ROBOT, 0, "tiny")
@@ -169,13 +187,32 @@ def test_experiment_runs_the_procedure_in_one_continuous_episode():
 
 
 def test_softbench_run_adaptive_end_to_end(tmp_path, capsys):
-  argv = ["run", "--task", "reach", "--agent", "smpl", "--adaptive", "--targets", "2",
-          "--profile", "tiny", "--results", str(tmp_path)]
+  argv = [
+    "run",
+    "--task",
+    "reach",
+    "--agent",
+    "smpl",
+    "--adaptive",
+    "--targets",
+    "2",
+    "--profile",
+    "tiny",
+    "--results",
+    str(tmp_path),
+  ]
   assert cli.main(argv) == 0
   out = capsys.readouterr().out
-  for text in ("adaptive module activation: smpl (agent seed 0) on reach (pneumatic-433), "
-               "module 2, 2 target(s)", "module 2 alone", "final (adaptive)", "all modules on",
-               "modules that ended active", "whole run", "holding the target"):
+  for text in (
+    "adaptive module activation: smpl (agent seed 0) on reach (pneumatic-433), "
+    "module 2, 2 target(s)",
+    "module 2 alone",
+    "final (adaptive)",
+    "all modules on",
+    "modules that ended active",
+    "whole run",
+    "holding the target",
+  ):
     assert text in out
   (path,) = tmp_path.glob("*.json")
   assert "-reach-adaptive-tiny-" in path.name
@@ -190,26 +227,35 @@ def test_softbench_run_adaptive_end_to_end(tmp_path, capsys):
   assert path.with_suffix(".png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
-@pytest.mark.parametrize("argv,message", [
+@pytest.mark.parametrize(
+  "argv,message",
+  [
     (["--task", "circle", "--agent", "smpl", "--adaptive"], "--adaptive goes with --task reach"),
-    (["--task", "reach", "--agent", "smpl", "--adaptive", "--module", "4"],
-     "module must be 1 to 3"),
-    (["--task", "reach", "--agent", "smpl", "--adaptive", "--targets", "0"],
-     "targets must be a positive integer"),
+    (
+      ["--task", "reach", "--agent", "smpl", "--adaptive", "--module", "4"],
+      "module must be 1 to 3",
+    ),
+    (
+      ["--task", "reach", "--agent", "smpl", "--adaptive", "--targets", "0"],
+      "targets must be a positive integer",
+    ),
     (["--task", "reach", "--agent", "smpl", "--targets", "3"], "go with --adaptive"),
     (["--task", "reach", "--agent", "zero", "--adaptive"], "needs an agent trained on babbling"),
     (["--task", "reach", "--agent", "smpl", "--adaptive", "--seeds", "3"], "vary --targets"),
-    (["--task", "reach", "--agent", "smpl", "--adaptive", "--helpers", "push"],
-     "unknown helpers"),
+    (["--task", "reach", "--agent", "smpl", "--adaptive", "--helpers", "push"], "unknown helpers"),
     (["--task", "circle", "--agent", "smpl", "--module", "2"], "--module goes with --task reach"),
-    (["--task", "reach", "--agent", "smpl", "--adaptive", "--fault", "2:0:0"],
-     "--fault and --adaptive"),
-    (["--task", "reach", "--agent", "smpl", "--adaptive", "--video", "reach.mp4"],
-     "--adaptive draws its own figure"),
-])
+    (
+      ["--task", "reach", "--agent", "smpl", "--adaptive", "--fault", "2:0:0"],
+      "--fault and --adaptive",
+    ),
+    (
+      ["--task", "reach", "--agent", "smpl", "--adaptive", "--video", "reach.mp4"],
+      "--adaptive draws its own figure",
+    ),
+  ],
+)
 def test_run_adaptive_refuses_bad_input_with_one_line(argv, message, capsys, tmp_path):
-  assert cli.main(["run", *argv, "--profile", "tiny", "--results", str(tmp_path)]) == \
-      cli.EXIT_USAGE
+  assert cli.main(["run", *argv, "--profile", "tiny", "--results", str(tmp_path)]) == cli.EXIT_USAGE
   lines = capsys.readouterr().err.strip().splitlines()
   assert len(lines) == 1 and message in lines[0]
   assert not list(tmp_path.glob("*"))

@@ -5,10 +5,10 @@ import pathlib
 import shutil
 import warnings
 
+from dm_control.rl import control
 import numpy as np
 import pytest
 import torch
-from dm_control.rl import control
 
 from softbench import agents
 from softbench import cli
@@ -24,8 +24,9 @@ from softbench.agents import forward_models
 from softbench.agents import learned
 
 # Every task of the suite on tendon-2, and one on the pneumatic arm.
-TASKS = tuple(pair for pair in suite.ALL_TASKS if pair[0] == "tendon-2") + (("pneumatic-433",
-                                                                            "spiral"),)
+TASKS = tuple(pair for pair in suite.ALL_TASKS if pair[0] == "tendon-2") + (
+  ("pneumatic-433", "spiral"),
+)
 EPISODE_STEPS = 4  # Control steps of each test episode.
 LEARNED_AGENTS = [name for name in agents.AGENTS if agents.describe(name).learned]
 
@@ -45,7 +46,6 @@ def episode(agent_name, robot, task, seed=0):
 @pytest.mark.parametrize("robot,task", TASKS)
 @pytest.mark.parametrize("agent_name", agents.AGENTS)
 class TestEveryAgent:
-
   def test_actions_are_finite_in_bounds_and_the_same_for_a_seed(self, agent_name, robot, task):
     # A learned agent is made again from its cached checkpoint the second time; training itself
     # is checked by test_training_from_scratch_is_deterministic.
@@ -59,6 +59,7 @@ class TestEveryAgent:
 def test_training_from_scratch_is_deterministic(agent_name, tmp_path, monkeypatch):
   """Two data homes, so that nothing is cached: the same seed trains to the same actions, and
   another seed to other actions."""
+
   def actions(home, seed):
     monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / home))
     return episode(agent_name, "tendon-2", "circle", seed).actions
@@ -69,8 +70,9 @@ def test_training_from_scratch_is_deterministic(agent_name, tmp_path, monkeypatc
 
 
 @pytest.mark.parametrize("agent_name", LEARNED_AGENTS)
-def test_checkpoint_round_trip_gives_identical_actions(agent_name, tmp_path, monkeypatch,
-                                                       assert_one_line_retraining):
+def test_checkpoint_round_trip_gives_identical_actions(
+  agent_name, tmp_path, monkeypatch, assert_one_line_retraining
+):
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
   trained = episode(agent_name, "tendon-2", "circle")  # Trains, then saves the checkpoint.
   (checkpoint,) = (tmp_path / learned.CHECKPOINT_FOLDER).glob(f"{agent_name}-*.pt")
@@ -84,14 +86,16 @@ def test_checkpoint_round_trip_gives_identical_actions(agent_name, tmp_path, mon
   np.testing.assert_array_equal(retrained.actions, trained.actions)
   with warnings.catch_warnings():
     warnings.simplefilter("error")  # Written again whole: it loads without a warning.
-    np.testing.assert_array_equal(episode(agent_name, "tendon-2", "circle").actions,
-                                  trained.actions)
+    np.testing.assert_array_equal(
+      episode(agent_name, "tendon-2", "circle").actions, trained.actions
+    )
   assert [path.name for path in checkpoint.parent.iterdir()] == [checkpoint.name]
 
 
 @pytest.mark.parametrize("damage", ["hello", "flipped weight"])
-def test_a_damaged_cached_forward_model_is_trained_again(damage, tmp_path, monkeypatch,
-                                                         assert_one_line_retraining):
+def test_a_damaged_cached_forward_model_is_trained_again(
+  damage, tmp_path, monkeypatch, assert_one_line_retraining
+):
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
   agents.make("mlp", "tendon-2", 0, "tiny")
   (forward,) = (tmp_path / forward_models.FOLDER).glob("*.pt")
@@ -117,8 +121,9 @@ def test_a_damaged_cached_forward_model_is_trained_again(damage, tmp_path, monke
     agents.make("mlp", "tendon-2", 0, "tiny")
 
 
-def test_a_folder_at_a_checkpoint_path_is_damage_reported_and_replaced(tmp_path, monkeypatch,
-                                                                       assert_one_line_retraining):
+def test_a_folder_at_a_checkpoint_path_is_damage_reported_and_replaced(
+  tmp_path, monkeypatch, assert_one_line_retraining
+):
   # The cache owns its paths: whatever stands where its file belongs is damage (one rule,
   # storage.read_cached), reported in one line and replaced by the trained checkpoint.
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
@@ -132,8 +137,9 @@ def test_a_folder_at_a_checkpoint_path_is_damage_reported_and_replaced(tmp_path,
 
 
 @pytest.mark.parametrize("agent_name", agents.babbling_learners())  # sac: in test_sac.
-def test_interrupted_training_resumes_to_the_same_checkpoint(agent_name, interrupted_training,
-                                                             tmp_path, monkeypatch):
+def test_interrupted_training_resumes_to_the_same_checkpoint(
+  agent_name, interrupted_training, tmp_path, monkeypatch
+):
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
   agents.make(agent_name, "tendon-2", 0, "tiny")
   (checkpoint,) = (tmp_path / learned.CHECKPOINT_FOLDER).glob(f"{agent_name}-*.pt")
@@ -199,8 +205,21 @@ def test_error_sources_differ_after_the_first_step(mode):
 def test_softbench_run_end_to_end(tmp_path, capsys):
   results = tmp_path / "results"
   extra = tmp_path / "record.json"
-  argv = ["run", "--task", "circle", "--agent", "smpl", "--robot", "tendon-2", "--profile",
-          "tiny", "--results", str(results), "--json", str(extra)]
+  argv = [
+    "run",
+    "--task",
+    "circle",
+    "--agent",
+    "smpl",
+    "--robot",
+    "tendon-2",
+    "--profile",
+    "tiny",
+    "--results",
+    str(results),
+    "--json",
+    str(extra),
+  ]
   assert cli.main(argv) == 0
   out = capsys.readouterr().out
   assert "smpl on circle (tendon-2), profile tiny, eval physics, 2 seed(s)" in out
@@ -209,9 +228,14 @@ def test_softbench_run_end_to_end(tmp_path, capsys):
   (path,) = results.glob("*.json")
   record = json.loads(path.read_text())
   assert record == json.loads(extra.read_text())
-  assert (record["agent"], record["robot"], record["task"], record["profile"],
-          record["eval_mode"], record["seeds"]) == ("smpl", "tendon-2", "circle", "tiny",
-                                                    "physics", 2)
+  assert (
+    record["agent"],
+    record["robot"],
+    record["task"],
+    record["profile"],
+    record["eval_mode"],
+    record["seeds"],
+  ) == ("smpl", "tendon-2", "circle", "tiny", "physics", 2)
   assert [entry["seed"] for entry in record["per_seed"]] == [0, 1]
   assert all(len(entry["position_mm"]["per_module"]) == 2 for entry in record["per_seed"])
   for field in ("softbench_version", "git_commit", "date", "machine", "wall_time_s"):
@@ -234,9 +258,23 @@ def test_the_worker_count_changes_no_result(tmp_path, monkeypatch):
   records = []
   for workers in ("1", "3"):  # 3 workers for 2 seeds: 2 processes.
     path = tmp_path / f"workers{workers}.json"
-    argv = ["run", "--task", "circle", "--agent", "random", "--robot", "tendon-1", "--profile",
-            "tiny", "--workers", workers, "--results", str(tmp_path / workers), "--json",
-            str(path)]
+    argv = [
+      "run",
+      "--task",
+      "circle",
+      "--agent",
+      "random",
+      "--robot",
+      "tendon-1",
+      "--profile",
+      "tiny",
+      "--workers",
+      workers,
+      "--results",
+      str(tmp_path / workers),
+      "--json",
+      str(path),
+    ]
     assert cli.main(argv) == 0
     records.append(json.loads(path.read_text()))
   assert asked == [1, 3]
@@ -245,7 +283,9 @@ def test_the_worker_count_changes_no_result(tmp_path, monkeypatch):
   assert records[0]["per_seed"][0] != records[0]["per_seed"][1]
 
 
-@pytest.mark.parametrize("argv,message", [
+@pytest.mark.parametrize(
+  "argv,message",
+  [
     (["--task", "juggle", "--agent", "smpl"], "unknown task"),
     (["--task", "circle", "--agent", "oracle"], "unknown agent"),
     (["--task", "circle", "--agent", "zero", "--robot", "tendon-0"], "1 to 10 modules"),
@@ -255,9 +295,21 @@ def test_the_worker_count_changes_no_result(tmp_path, monkeypatch):
     (["--task", "circle", "--agent", "zero", "--profile", "huge"], "unknown profile"),
     (["--task", "circle", "--agent", "zero", "--eval", "dream"], "unknown eval mode"),
     (["--task", "custom", "--agent", "zero"], "--trajectory"),
-    (["--task", "custom", "--agent", "zero", "--profile", "tiny", "--trajectory",
-      "/nonexistent.npy"], "does not exist"),
-])
+    (
+      [
+        "--task",
+        "custom",
+        "--agent",
+        "zero",
+        "--profile",
+        "tiny",
+        "--trajectory",
+        "/nonexistent.npy",
+      ],
+      "does not exist",
+    ),
+  ],
+)
 def test_run_refuses_bad_input_with_one_line(argv, message, capsys, tmp_path):
   assert cli.main(["run", *argv, "--results", str(tmp_path)]) == cli.EXIT_USAGE
   lines = capsys.readouterr().err.strip().splitlines()
@@ -274,39 +326,66 @@ def _bad_trajectories(folder: pathlib.Path) -> dict[str, tuple[str, str]]:
   # Finite but absurd: positions of 1e300 m once ran every episode, printed inf ± nan and failed
   # writing the record, leaving saved seeds that failed the same way on every rerun.
   pose = np.array([0.0, 0.0, -0.05, 0.0, 0.0, -1.0])
-  np.savetxt(folder / "far.csv", np.tile(np.concatenate([pose, pose * [1, 1, 1e302, 1, 1, 1]]),
-                                         (3, 1)), delimiter=",")
+  np.savetxt(
+    folder / "far.csv",
+    np.tile(np.concatenate([pose, pose * [1, 1, 1e302, 1, 1, 1]]), (3, 1)),
+    delimiter=",",
+  )
   long_axis = np.concatenate([pose, pose * [1, 1, 1, 1, 1, 1e300]])
-  np.savetxt(folder / "long-axis.csv", np.tile(long_axis, (3, 1)),
-             delimiter=",")
-  return {"missing": ("nowhere.csv", "does not exist"),
-          "far": ("far.csv", "arm lengths) from the base of tendon-2"),
-          "long axis": ("long-axis.csv", "unit length"),
-          "wrong shape": ("wrong-shape.csv", "must have shape (steps, 12)"),
-          "empty": ("empty.csv", "trajectory"),
-          "complex": ("complex.npy", "real numbers"),
-          "folder": ("a-folder.csv", "is a folder")}
+  np.savetxt(folder / "long-axis.csv", np.tile(long_axis, (3, 1)), delimiter=",")
+  return {
+    "missing": ("nowhere.csv", "does not exist"),
+    "far": ("far.csv", "arm lengths) from the base of tendon-2"),
+    "long axis": ("long-axis.csv", "unit length"),
+    "wrong shape": ("wrong-shape.csv", "must have shape (steps, 12)"),
+    "empty": ("empty.csv", "trajectory"),
+    "complex": ("complex.npy", "real numbers"),
+    "folder": ("a-folder.csv", "is a folder"),
+  }
 
 
-@pytest.mark.parametrize("case", ["missing", "wrong shape", "empty", "complex", "folder", "far",
-                                  "long axis"])
-def test_a_bad_trajectory_is_refused_before_any_collection_or_training(case, capsys, tmp_path,
-                                                                         monkeypatch):
+@pytest.mark.parametrize(
+  "case", ["missing", "wrong shape", "empty", "complex", "folder", "far", "long axis"]
+)
+def test_a_bad_trajectory_is_refused_before_any_collection_or_training(
+  case, capsys, tmp_path, monkeypatch
+):
   home = tmp_path / "home"
   monkeypatch.setenv("SOFTBENCH_HOME", str(home))
   name, message = _bad_trajectories(tmp_path)[case]
-  argv = ["run", "--task", "custom", "--agent", "lstm", "--robot", "tendon-2", "--profile",
-          "tiny", "--trajectory", str(tmp_path / name), "--results", str(tmp_path)]
+  argv = [
+    "run",
+    "--task",
+    "custom",
+    "--agent",
+    "lstm",
+    "--robot",
+    "tendon-2",
+    "--profile",
+    "tiny",
+    "--trajectory",
+    str(tmp_path / name),
+    "--results",
+    str(tmp_path),
+  ]
   assert cli.main(argv) == cli.EXIT_USAGE
   lines = capsys.readouterr().err.strip().splitlines()
   assert len(lines) == 1 and message in lines[0], lines
   assert not home.exists()  # No dataset, no checkpoint, no reference.
 
 
-@pytest.mark.parametrize("flags", [["--width", "320"], ["--camera", "top"], ["--fps", "-1"],
-                                   ["--frames-per-step", "2", "--height", "240"]])
-@pytest.mark.parametrize("command", [["--task", "circle", "--agent", "zero"],
-                                     ["--protocol", "exp1s", "--agent", "smpl"]])
+@pytest.mark.parametrize(
+  "flags",
+  [
+    ["--width", "320"],
+    ["--camera", "top"],
+    ["--fps", "-1"],
+    ["--frames-per-step", "2", "--height", "240"],
+  ],
+)
+@pytest.mark.parametrize(
+  "command", [["--task", "circle", "--agent", "zero"], ["--protocol", "exp1s", "--agent", "smpl"]]
+)
 def test_video_flags_without_a_video_are_refused(command, flags, capsys, tmp_path, monkeypatch):
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / "home"))
   assert cli.main(["run", *command, *flags, "--results", str(tmp_path)]) == cli.EXIT_USAGE
@@ -316,18 +395,26 @@ def test_video_flags_without_a_video_are_refused(command, flags, capsys, tmp_pat
   assert not (tmp_path / "home").exists()
 
 
-@pytest.mark.parametrize("outputs,message", [
+@pytest.mark.parametrize(
+  "outputs,message",
+  [
     (["--results", "a-file"], "it is a file"),
     (["--results", "a-file/records"], "is not a folder"),
     (["--json", "a-folder"], "it is a folder"),
     (["--json", "a-file/record.json"], "is not a folder"),
-])
-@pytest.mark.parametrize("command", [["run", "--task", "circle", "--agent", "lstm"],
-                                     ["run", "--protocol", "exp1s", "--agent", "smpl"],
-                                     ["retrain", "--fault", "2:0:0"]])
-def test_outputs_that_cannot_be_written_are_refused_before_the_run(command, outputs, message,
-                                                                     capsys, tmp_path,
-                                                                     monkeypatch):
+  ],
+)
+@pytest.mark.parametrize(
+  "command",
+  [
+    ["run", "--task", "circle", "--agent", "lstm"],
+    ["run", "--protocol", "exp1s", "--agent", "smpl"],
+    ["retrain", "--fault", "2:0:0"],
+  ],
+)
+def test_outputs_that_cannot_be_written_are_refused_before_the_run(
+  command, outputs, message, capsys, tmp_path, monkeypatch
+):
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / "home"))
   monkeypatch.chdir(tmp_path)
   (tmp_path / "a-file").write_text("")
@@ -349,13 +436,16 @@ def test_a_data_home_that_cannot_be_used_is_one_line(capsys, tmp_path, monkeypat
   assert "a-file" in error_lines[0] and "it is a file" in error_lines[0]
 
 
-@pytest.mark.parametrize("argv", [
+@pytest.mark.parametrize(
+  "argv",
+  [
     ["run", "--task", "circle", "--agent", "zero", "--seeds", "x"],
     ["run", "--task"],
     ["frobnicate"],
     [],
     ["models"],
-])
+  ],
+)
 def test_a_malformed_command_line_is_one_line_and_exit_2(argv, capsys):
   assert cli.main(argv) == cli.EXIT_USAGE
   captured = capsys.readouterr()
@@ -372,8 +462,12 @@ def test_help_still_prints_the_usage(capsys):
 def test_warnings_print_on_one_line(monkeypatch):
   monkeypatch.setattr(warnings, "formatwarning", warnings.formatwarning)  # Restored afterwards.
   parallel_seeds.one_line_warnings()
-  assert warnings.formatwarning("snapshot unreadable", RuntimeWarning, "training.py", 215,
-                                "saved = load()") == "softbench: warning: snapshot unreadable\n"
+  assert (
+    warnings.formatwarning(
+      "snapshot unreadable", RuntimeWarning, "training.py", 215, "saved = load()"
+    )
+    == "softbench: warning: snapshot unreadable\n"
+  )
 
 
 def test_cli_lists_agents(capsys):
@@ -387,11 +481,26 @@ def test_an_unstable_simulation_is_one_line(capsys, tmp_path, monkeypatch):
     raise control.PhysicsError("Physics state is invalid. Warning(s) raised: mjWARN_BADQACC")
 
   monkeypatch.setattr(evaluation, "run_episode", blows_up)
-  argv = ["run", "--task", "circle", "--agent", "zero", "--robot", "tendon-1", "--seeds", "1",
-          "--profile", "tiny", "--results", str(tmp_path)]
+  argv = [
+    "run",
+    "--task",
+    "circle",
+    "--agent",
+    "zero",
+    "--robot",
+    "tendon-1",
+    "--seeds",
+    "1",
+    "--profile",
+    "tiny",
+    "--results",
+    str(tmp_path),
+  ]
   assert cli.main(argv) == cli.EXIT_FAILURE
   err = capsys.readouterr().err
   assert "Traceback" not in err
-  assert err.strip().splitlines()[-1] == ("softbench: error: the simulation became unstable "
-                                          "(Physics state is invalid. Warning(s) raised: "
-                                          "mjWARN_BADQACC)")
+  assert err.strip().splitlines()[-1] == (
+    "softbench: error: the simulation became unstable "
+    "(Physics state is invalid. Warning(s) raised: "
+    "mjWARN_BADQACC)"
+  )

@@ -75,8 +75,9 @@ def reach_episode(name: str, robot: str, seed: int = 0) -> Episode:
   return run_episode(agents.make(name, robot, seed), env, "reach")
 
 
-def tip_error_percent(name: str, robot: str, task: str, max_steps: int | None = None,
-                      **options) -> float:
+def tip_error_percent(
+  name: str, robot: str, task: str, max_steps: int | None = None, **options
+) -> float:
   """Mean normalised tip error (%) of agent ``name`` over (the first ``max_steps`` steps of) an
   episode of ``task``."""
   env = suite.load(robot, task, seed=0, **options)
@@ -88,7 +89,6 @@ def tip_error_percent(name: str, robot: str, task: str, max_steps: int | None = 
 @pytest.mark.parametrize("robot", robots.BENCHMARK_ROBOTS)
 @pytest.mark.parametrize("name", UNTRAINED_AGENTS)
 class TestEveryAgent:
-
   def test_actions_are_finite_and_in_bounds(self, name, robot):
     actions = reach_episode(name, robot).actions
     assert actions.shape == (REACH_STEPS, robots.make(robot).action_dim)
@@ -128,9 +128,14 @@ def test_reference_agent_needs_the_physics():
 
 def test_reference_agent_does_not_depend_on_the_thread_count():
   # Explicit counts: the default is the machine's core count, which may be 1.
-  single, several = (run_episode(reference.ReferenceAgent(robots.make("tendon-3"), 0, threads),
-                                 suite.load("tendon-3", "reach", seed=0, steps=REACH_STEPS),
-                                 "reach") for threads in (1, 4))
+  single, several = (
+    run_episode(
+      reference.ReferenceAgent(robots.make("tendon-3"), 0, threads),
+      suite.load("tendon-3", "reach", seed=0, steps=REACH_STEPS),
+      "reach",
+    )
+    for threads in (1, 4)
+  )
   np.testing.assert_array_equal(single.actions, several.actions)
 
 
@@ -142,11 +147,14 @@ def test_reference_agent_forgets_its_restart_memory_between_episodes():
 
   used = agents.make("reference", "tendon-3")
   babbling_actions(used, env_seed=1)
-  np.testing.assert_array_equal(babbling_actions(used, env_seed=0),
-                                babbling_actions(agents.make("reference", "tendon-3"), 0))
+  np.testing.assert_array_equal(
+    babbling_actions(used, env_seed=0), babbling_actions(agents.make("reference", "tendon-3"), 0)
+  )
 
 
-@pytest.mark.parametrize("robot,task,options", [
+@pytest.mark.parametrize(
+  "robot,task,options",
+  [
     # Measured (mean normalised tip error, zero agent -> reference agent): tendon-2 circle
     # 21.2 % -> 0.0003 %, pneumatic-433 circle 15.6 % -> 0.012 %, tendon-3 reach (module 2)
     # 29.3 % -> 0.002 %. Babbling targets jump across the workspace every step: tendon-3, first
@@ -158,7 +166,8 @@ def test_reference_agent_forgets_its_restart_memory_between_episodes():
     ("tendon-3", "babbling", {"length": BABBLING_LENGTH, "max_steps": BABBLING_SCORED_STEPS}),
     ("pneumatic-433", "circle", {"length": CIRCLE_LENGTH, "max_steps": TRACKING_STEPS}),
     ("tendon-3", "reach", {"steps": REACH_STEPS}),
-])
+  ],
+)
 def test_reference_agent_tracks_far_better_than_zero(robot, task, options):
   reference = tip_error_percent("reference", robot, task, **options)
   zero = tip_error_percent("zero", robot, task, **options)
@@ -177,8 +186,9 @@ np.save(sys.argv[1], episode.actions)
 """
 
 
-@pytest.mark.skipif(platform.machine().lower() not in ("x86_64", "amd64"),
-                    reason="OpenBLAS's x86-64 kernels")
+@pytest.mark.skipif(
+  platform.machine().lower() not in ("x86_64", "amd64"), reason="OpenBLAS's x86-64 kernels"
+)
 def test_reference_actions_do_not_depend_on_the_cpus_blas_kernels(tmp_path):
   # numpy's OpenBLAS picks its kernels by CPU; with numpy's algebra, the first babbling restart
   # (step 3) stalled 9 to 46 mm off with the AVX-512 kernels, 6 to 31 mm with the SSE ones and
@@ -191,10 +201,17 @@ def test_reference_actions_do_not_depend_on_the_cpus_blas_kernels(tmp_path):
     if kernel:
       environment["OPENBLAS_CORETYPE"] = kernel
     path = tmp_path / f"{kernel}.npy"
-    subprocess.run([sys.executable, "-c", _BABBLING_ACTIONS_PROGRAM, str(path)], check=True,
-                   env={**environment, "PYTHONPATH": os.pathsep.join(
-                       [str(pathlib.Path(__file__).parent), environment.get("PYTHONPATH", "")])},
-                   timeout=300)
+    subprocess.run(
+      [sys.executable, "-c", _BABBLING_ACTIONS_PROGRAM, str(path)],
+      check=True,
+      env={
+        **environment,
+        "PYTHONPATH": os.pathsep.join(
+          [str(pathlib.Path(__file__).parent), environment.get("PYTHONPATH", "")]
+        ),
+      },
+      timeout=300,
+    )
     actions[kernel] = np.load(path)
   assert actions["Nehalem"].shape == (BABBLING_STEPS, robots.make("tendon-3").action_dim)
   np.testing.assert_array_equal(actions["Nehalem"], actions[None])

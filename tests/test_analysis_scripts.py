@@ -1,5 +1,5 @@
-"""The scripts behind the docs' figures (docs/analysis) keep running against the current API, on tiny
-data; the early-stopping script's best-validation agent is the one `softbench run` trains."""
+"""The scripts behind the docs' figures (docs/analysis) keep running against the current API, on
+tiny data; the early-stopping script's best-validation agent is the one `softbench run` trains."""
 
 import importlib.util
 import json
@@ -33,8 +33,7 @@ def run_script(name: str, arguments: list[str], monkeypatch, capsys) -> str:
 
 def test_action_identifiability_reports_every_module_in_both_views(monkeypatch, capsys):
   data.collect("tendon-2", samples=200, seed=0, progress=False)
-  out = run_script("action_identifiability", ["tendon-2", "--samples", "200"], monkeypatch,
-                   capsys)
+  out = run_script("action_identifiability", ["tendon-2", "--samples", "200"], monkeypatch, capsys)
   for split in data.SPLITS:
     assert re.search(rf"^  {split} +tip mean", out, re.MULTILINE)
   assert re.findall(r"^  module (\d): residual variance", out, re.MULTILINE) == ["1", "2"]
@@ -44,42 +43,106 @@ def test_action_identifiability_reports_every_module_in_both_views(monkeypatch, 
 
 
 def test_early_stopping_keeps_the_agent_softbench_run_trains(monkeypatch, capsys):
-  out = run_script("early_stopping", ["--agent", "lstm", "--robot", "tendon-1", "--task",
-                                      "circle", "--profile", "tiny", "--epochs", "2", "--keep",
-                                      "1", "2"], monkeypatch, capsys)
-  scores = dict(re.findall(r"seed 0, (best validation|after epoch \d)[^:]*: position error "
-                           r"([0-9.]+) mm", out))
+  out = run_script(
+    "early_stopping",
+    [
+      "--agent",
+      "lstm",
+      "--robot",
+      "tendon-1",
+      "--task",
+      "circle",
+      "--profile",
+      "tiny",
+      "--epochs",
+      "2",
+      "--keep",
+      "1",
+      "2",
+    ],
+    monkeypatch,
+    capsys,
+  )
+  scores = dict(
+    re.findall(
+      r"seed 0, (best validation|after epoch \d)[^:]*: position error "
+      r"([0-9.]+) mm",
+      out,
+    )
+  )
   assert set(scores) == {"best validation", "after epoch 1", "after epoch 2"}
-  record = run.execute(run.settings("circle", "lstm", "tendon-1", seeds=1, profile="tiny"),
-                       show_progress=False, workers=1)
+  record = run.execute(
+    run.settings("circle", "lstm", "tendon-1", seeds=1, profile="tiny"),
+    show_progress=False,
+    workers=1,
+  )
   assert scores["best validation"] == f"{record['per_seed'][0]['position_mm']['mean']:.2f}"
 
 
 def test_validation_loss_reports_every_seed_of_every_agent(monkeypatch, capsys):
-  out = run_script("validation_loss", ["--agents", "mlp", "--robot", "tendon-1", "--profile",
-                                       "tiny", "--seeds", "2"], monkeypatch, capsys)
-  losses = re.findall(r"^mlp seed (\d): validation loss ([0-9.]+), test loss ([0-9.]+)$", out,
-                      re.MULTILINE)
+  out = run_script(
+    "validation_loss",
+    ["--agents", "mlp", "--robot", "tendon-1", "--profile", "tiny", "--seeds", "2"],
+    monkeypatch,
+    capsys,
+  )
+  losses = re.findall(
+    r"^mlp seed (\d): validation loss ([0-9.]+), test loss ([0-9.]+)$", out, re.MULTILINE
+  )
   assert [seed for seed, _, _ in losses] == ["0", "1"]
-  assert all(0 < float(validation) < 10 and 0 < float(test) < 10
-             for _, validation, test in losses)
+  assert all(0 < float(validation) < 10 and 0 < float(test) < 10 for _, validation, test in losses)
   assert losses[0][1:] != losses[1][1:]  # Each seed its own model.
 
 
-def test_exp1s_column_retrains_the_column_exp1s_trained(two_stages, monkeypatch, capsys,
-                                                       tmp_path):
+def test_exp1s_column_retrains_the_column_exp1s_trained(two_stages, monkeypatch, capsys, tmp_path):
   results = tmp_path / "results"
-  assert cli.main(["run", "--protocol", "exp1s", "--agent", "smpl", "--profile", "tiny",
-                   "--seeds", "1", "--results", str(results)]) == 0
+  assert (
+    cli.main(
+      [
+        "run",
+        "--protocol",
+        "exp1s",
+        "--agent",
+        "smpl",
+        "--profile",
+        "tiny",
+        "--seeds",
+        "1",
+        "--results",
+        str(results),
+      ]
+    )
+    == 0
+  )
   (path,) = results.glob("smpl-exp1s-tiny-*.json")
   spiral = json.loads(path.read_text())["per_seed"][0]["scores"]["closed"]["spiral"][1]
   capsys.readouterr()
   # The tiny profile trains 2 epochs without stopping early: the run's own settings.
-  out = run_script("exp1s_column", ["--configuration", "2", "--seed", "0", "--profile", "tiny",
-                                    "--epochs", "2", "--settings", "tuned:0", "tuned:1",
-                                    "--tasks", "spiral"], monkeypatch, capsys)
-  scores = re.findall(r"pose-loss weight (\d+): tendon-2 spiral, closed loop in physics: end "
-                      r"effector ([0-9.]+) mm, ([0-9.]+) deg", out)
+  out = run_script(
+    "exp1s_column",
+    [
+      "--configuration",
+      "2",
+      "--seed",
+      "0",
+      "--profile",
+      "tiny",
+      "--epochs",
+      "2",
+      "--settings",
+      "tuned:0",
+      "tuned:1",
+      "--tasks",
+      "spiral",
+    ],
+    monkeypatch,
+    capsys,
+  )
+  scores = re.findall(
+    r"pose-loss weight (\d+): tendon-2 spiral, closed loop in physics: end "
+    r"effector ([0-9.]+) mm, ([0-9.]+) deg",
+    out,
+  )
   assert [weight for weight, _, _ in scores] == ["0", "1"]
   assert scores[0][1:] == (f"{spiral['position_mm']:.2f}", f"{spiral['orientation_deg']:.2f}")
   assert len(re.findall(r"best validation [0-9.]+ at epoch [12]; test action MSE", out)) == 2
@@ -88,8 +151,12 @@ def test_exp1s_column_retrains_the_column_exp1s_trained(two_stages, monkeypatch,
 def test_forward_coupling_compares_both_forward_models_of_every_module(monkeypatch, capsys):
   data.collect("tendon-local-2", samples=200, seed=0, progress=False)
   out = run_script("forward_coupling", ["tendon-local-2", "--profile", "tiny"], monkeypatch, capsys)
-  found = re.findall(r"^tendon-local-2 module (\d): .* actuation ([0-9.]+), from every module's "
-                     r"([0-9.]+) \(ratio ([0-9.]+)\)$", out, re.MULTILINE)
+  found = re.findall(
+    r"^tendon-local-2 module (\d): .* actuation ([0-9.]+), from every module's "
+    r"([0-9.]+) \(ratio ([0-9.]+)\)$",
+    out,
+    re.MULTILINE,
+  )
   assert [module for module, *_ in found] == ["1", "2"]
   for _, own, every, ratio in found:
     assert float(own) > 0 and float(every) > 0

@@ -5,8 +5,8 @@ line naming the file, made again, and the result is what an undamaged cache give
 
 import dataclasses
 import pathlib
-import warnings
 from typing import Callable
+import warnings
 
 import numpy as np
 import pytest
@@ -57,8 +57,9 @@ def _agent() -> dict:
 
 def _forward() -> dict:
   arm = suite.robots.make(ROBOT)
-  _, (model,) = learned.trained_forward_models(arm, [data.View.whole_arm(arm)], 0,
-                                               profiles.get("tiny"))
+  _, (model,) = learned.trained_forward_models(
+    arm, [data.View.whole_arm(arm)], 0, profiles.get("tiny")
+  )
   return {name: tensor.numpy() for name, tensor in model.state_dict().items()}
 
 
@@ -111,48 +112,61 @@ def _only(home: pathlib.Path, pattern: str) -> pathlib.Path:
 
 
 CACHES = {
-    "dataset": Cache(_dataset, lambda home: _only(home, f"datasets/*/{dataset.NPZ_NAME}")),
-    "dataset manifest": Cache(_dataset,
-                              lambda home: _only(home, f"datasets/*/{dataset.JSON_NAME}"),
-                              zip=False),
-    "babbling chunk": Cache(_chunk, lambda home: _only(_chunk_folder(home), "chunk-*.npz")),
-    "reference": Cache(_reference, lambda home: _only(home, "references/*.npz")),
-    "reference description": Cache(_reference, lambda home: _only(home, "references/*.json"),
-                                   zip=False),
-    "checkpoint": Cache(_agent, lambda home: _only(home, f"{learned.CHECKPOINT_FOLDER}/*.pt")),
-    "forward model": Cache(_forward, lambda home: _only(home, f"{forward_models.FOLDER}/*.pt")),
-    "saved episode": Cache(_episode, lambda home: _only(home, "runs/*/seed0.npz")),
-    "saved scores": Cache(_scores, _scores_path, zip=False),
+  "dataset": Cache(_dataset, lambda home: _only(home, f"datasets/*/{dataset.NPZ_NAME}")),
+  "dataset manifest": Cache(
+    _dataset, lambda home: _only(home, f"datasets/*/{dataset.JSON_NAME}"), zip=False
+  ),
+  "babbling chunk": Cache(_chunk, lambda home: _only(_chunk_folder(home), "chunk-*.npz")),
+  "reference": Cache(_reference, lambda home: _only(home, "references/*.npz")),
+  "reference description": Cache(
+    _reference, lambda home: _only(home, "references/*.json"), zip=False
+  ),
+  "checkpoint": Cache(_agent, lambda home: _only(home, f"{learned.CHECKPOINT_FOLDER}/*.pt")),
+  "forward model": Cache(_forward, lambda home: _only(home, f"{forward_models.FOLDER}/*.pt")),
+  "saved episode": Cache(_episode, lambda home: _only(home, "runs/*/seed0.npz")),
+  "saved scores": Cache(_scores, _scores_path, zip=False),
 }
 
 
 def _zip_field(offset: int, value: bytes) -> Callable[[bytes], bytes]:
   """Sets a field of the first central-directory entry of a zip (npz, torch) file, which is
   where readers look for flags, compression and version."""
+
   def damage(content: bytes) -> bytes:
     at = content.index(b"PK\x01\x02") + offset
-    return content[:at] + value + content[at + len(value):]
+    return content[:at] + value + content[at + len(value) :]
+
   return damage
 
 
 DAMAGES = {
-    "truncated": lambda content: content[:len(content) // 2],
-    "empty": lambda content: b"",
-    "bit flipped": lambda content: (content[:len(content) // 2]
-                                    + bytes([content[len(content) // 2] ^ 0x10])
-                                    + content[len(content) // 2 + 1:]),
-    "zip encrypted flag": _zip_field(8, b"\x01\x00"),
-    "zip unknown compression": _zip_field(10, b"\x63\x00"),
-    "zip version needed": _zip_field(6, b"\xff\x00"),
-    "a folder in its place": None,
+  "truncated": lambda content: content[: len(content) // 2],
+  "empty": lambda content: b"",
+  "bit flipped": lambda content: (
+    content[: len(content) // 2]
+    + bytes([content[len(content) // 2] ^ 0x10])
+    + content[len(content) // 2 + 1 :]
+  ),
+  "zip encrypted flag": _zip_field(8, b"\x01\x00"),
+  "zip unknown compression": _zip_field(10, b"\x63\x00"),
+  "zip version needed": _zip_field(6, b"\xff\x00"),
+  "a folder in its place": None,
 }
 ZIP_DAMAGES = {name for name in DAMAGES if name.startswith("zip")}
 
 
-@pytest.mark.parametrize("kind,damage", [(kind, damage) for kind in CACHES for damage in DAMAGES
-                                          if CACHES[kind].zip or damage not in ZIP_DAMAGES])
-def test_a_damaged_cache_file_is_reported_in_one_line_and_made_again(kind, damage, tmp_path,
-                                                                    monkeypatch):
+@pytest.mark.parametrize(
+  "kind,damage",
+  [
+    (kind, damage)
+    for kind in CACHES
+    for damage in DAMAGES
+    if CACHES[kind].zip or damage not in ZIP_DAMAGES
+  ],
+)
+def test_a_damaged_cache_file_is_reported_in_one_line_and_made_again(
+  kind, damage, tmp_path, monkeypatch
+):
   monkeypatch.setenv(storage.HOME_VARIABLE, str(tmp_path))
   cache = CACHES[kind]
   intact = cache.use()
@@ -167,8 +181,9 @@ def test_a_damaged_cache_file_is_reported_in_one_line_and_made_again(kind, damag
   with warnings.catch_warnings(record=True) as caught:
     warnings.simplefilter("always")
     again = cache.use()
-  reported = [str(entry.message) for entry in caught
-              if entry.category is storage.CorruptFileWarning]
+  reported = [
+    str(entry.message) for entry in caught if entry.category is storage.CorruptFileWarning
+  ]
   # A zip flag that the reader ignores (torch's reader and the version field) leaves the file
   # usable as it is; any other damage is reported.
   assert len(reported) == (0 if damage in ZIP_DAMAGES and not reported else 1)
@@ -180,4 +195,3 @@ def test_a_damaged_cache_file_is_reported_in_one_line_and_made_again(kind, damag
     warnings.simplefilter("error")  # Made again intact: read back without a word.
     cache.use()
   assert path.is_file()
-

@@ -19,13 +19,30 @@ from softbench.agents import learned
 @pytest.mark.parametrize("family", robots.TENDON_FAMILIES)
 def test_exp1s_end_to_end(family, two_stages, tmp_path, capsys):
   results = tmp_path / "results"
-  argv = ["run", "--protocol", "exp1s", "--agent", "smpl", "--profile", "tiny", "--seeds", "1",
-          "--results", str(results), "--family", family]
+  argv = [
+    "run",
+    "--protocol",
+    "exp1s",
+    "--agent",
+    "smpl",
+    "--profile",
+    "tiny",
+    "--seeds",
+    "1",
+    "--results",
+    str(results),
+    "--family",
+    family,
+  ]
   stages = [f"{family}-{robots.make(name).num_modules}" for name in two_stages]
   assert cli.main(argv) == 0
   out = capsys.readouterr().out
-  for heading in ("closed loop, position (mm)", "open loop, position (mm)",
-                  "closed loop, normalised tip error (%)", "forgetting matrix"):
+  for heading in (
+    "closed loop, position (mm)",
+    "open loop, position (mm)",
+    "closed loop, normalised tip error (%)",
+    "forgetting matrix",
+  ):
     assert heading in out
   named = "" if family == continual.DEFAULT_FAMILY else f"{family}-"
   (path,) = results.glob(f"smpl-exp1s-{named}tiny-*.json")
@@ -62,10 +79,22 @@ def test_forgetting_is_detected():
 
 def test_detected_forgetting_is_one_line_and_a_failure(two_stages, monkeypatch, tmp_path, capsys):
   changed = np.array([[0.5, np.nan], [0.25, 0.2]])
-  monkeypatch.setattr(continual, "run_seed",
-                      lambda *arguments: continual.check_no_forgetting(changed))
-  argv = ["run", "--protocol", "exp1s", "--agent", "smpl", "--profile", "tiny", "--seeds", "1",
-          "--results", str(tmp_path / "results")]
+  monkeypatch.setattr(
+    continual, "run_seed", lambda *arguments: continual.check_no_forgetting(changed)
+  )
+  argv = [
+    "run",
+    "--protocol",
+    "exp1s",
+    "--agent",
+    "smpl",
+    "--profile",
+    "tiny",
+    "--seeds",
+    "1",
+    "--results",
+    str(tmp_path / "results"),
+  ]
   assert cli.main(argv) == cli.EXIT_FAILURE
   errors = capsys.readouterr().err
   assert "Traceback" not in errors
@@ -74,13 +103,16 @@ def test_detected_forgetting_is_one_line_and_a_failure(two_stages, monkeypatch, 
   assert not (tmp_path / "results").exists()
 
 
-@pytest.mark.parametrize("extra,message", [
+@pytest.mark.parametrize(
+  "extra,message",
+  [
     (["--agent", "lstm"], "takes --agent smpl"),
     (["--agent", "smpl", "--task", "spiral"], "drop --task"),
     (["--agent", "smpl", "--eval", "model"], "drop --eval"),
     (["--agent", "smpl", "--family", "tendon-loc"], "unknown tendon family 'tendon-loc'"),
     (["--agent", "smpl", "--family", "pneumatic"], "unknown tendon family 'pneumatic'"),
-])
+  ],
+)
 def test_exp1s_refuses_bad_input_with_one_line(extra, message, capsys, tmp_path):
   argv = ["run", "--protocol", "exp1s", *extra, "--results", str(tmp_path)]
   assert cli.main(argv) == cli.EXIT_USAGE
@@ -92,7 +124,8 @@ def test_unknown_protocol_and_missing_task(capsys):
   assert cli.main(["run", "--protocol", "exp9", "--agent", "smpl"]) == cli.EXIT_USAGE
   assert cli.main(["run", "--agent", "smpl"]) == cli.EXIT_USAGE
   assert cli.main(["run", "--task", "spiral", "--agent", "smpl", "--family", "tendon-local"]) == (
-      cli.EXIT_USAGE)
+    cli.EXIT_USAGE
+  )
   lines = capsys.readouterr().err.strip().splitlines()
   assert "unknown protocol" in lines[0] and "needs --task" in lines[1]
   assert "--family goes with --protocol exp1s" in lines[2]
@@ -106,8 +139,9 @@ def test_exp1s_refuses_per_run_options(extra, capsys, tmp_path):
   assert len(lines) == 1 and f"drop {extra[0]}" in lines[0]
 
 
-def test_a_damaged_cached_network_is_trained_again(two_stages, tmp_path,
-                                                   assert_one_line_retraining):
+def test_a_damaged_cached_network_is_trained_again(
+  two_stages, tmp_path, assert_one_line_retraining
+):
   tiny = profiles.get("tiny")
   first = continual.build(0, tiny)
   (path,) = (tmp_path / "home" / learned.CHECKPOINT_FOLDER).glob("exp1s-*.pt")
@@ -118,8 +152,9 @@ def test_a_damaged_cached_network_is_trained_again(two_stages, tmp_path,
   first_state, again_state = first.network.state_dict(), again.network.state_dict()
   assert all(torch.equal(first_state[name], again_state[name]) for name in first_state)
   np.testing.assert_array_equal(again.forgetting_pose_mse, first.forgetting_pose_mse)
-  np.testing.assert_array_equal(continual.build(0, tiny).forgetting_action_mse,
-                                first.forgetting_action_mse)  # Loaded from the new file.
+  np.testing.assert_array_equal(
+    continual.build(0, tiny).forgetting_action_mse, first.forgetting_action_mse
+  )  # Loaded from the new file.
 
 
 def test_an_interrupted_exp1s_resumes_from_its_finished_seeds(two_stages, monkeypatch):
@@ -144,7 +179,8 @@ def test_an_interrupted_exp1s_resumes_from_its_finished_seeds(two_stages, monkey
 
 
 def test_a_seed_interrupted_in_its_evaluation_resumes_from_its_finished_episodes(
-    two_stages, monkeypatch, capsys):
+  two_stages, monkeypatch, capsys
+):
   tiny, episodes, run_episode = profiles.get("tiny"), [], continual.evaluation.run_episode
   total = len(two_stages) * len(continual.LOOPS) * len(continual.TASKS)
   finished_before_interruption = 5
@@ -163,8 +199,10 @@ def test_a_seed_interrupted_in_its_evaluation_resumes_from_its_finished_episodes
   assert len(list(kept.glob("seed0-*.json"))) == finished_before_interruption
   resumed = True
   scores = continual.run_seed(0, tiny, show_progress=True)
-  assert (f"resuming seed 0: {finished_before_interruption} of its {total} episodes"
-          in capsys.readouterr().err)
+  assert (
+    f"resuming seed 0: {finished_before_interruption} of its {total} episodes"
+    in capsys.readouterr().err
+  )
   assert len(episodes) == total and len(set(episodes)) == total  # None ran twice.
   episode_snapshots.discard_folder(continual.finished_seeds_folder(tiny))
   assert continual.run_seed(0, tiny) == scores  # Uninterrupted: the same scores.
@@ -181,12 +219,18 @@ def test_damaged_saved_exp1s_scores_run_again(two_stages, monkeypatch):
   assert json.loads(path.read_text())["scores"] == expected  # Saved again.
   # With the seed's file gone, a damaged episode's file runs that episode alone again.
   path.unlink()
-  episode = continual.finished_seeds_folder(tiny) / continual.EPISODES_FOLDER / (
-      "seed0-configuration2-closed-spiral.json")
+  episode = (
+    continual.finished_seeds_folder(tiny)
+    / continual.EPISODES_FOLDER
+    / ("seed0-configuration2-closed-spiral.json")
+  )
   episode.write_text(episode.read_text()[:-5])  # Truncated.
   ran, run_episode = [], continual.evaluation.run_episode
-  monkeypatch.setattr(continual.evaluation, "run_episode",
-                      lambda *arguments: ran.append(arguments[2]) or run_episode(*arguments))
+  monkeypatch.setattr(
+    continual.evaluation,
+    "run_episode",
+    lambda *arguments: ran.append(arguments[2]) or run_episode(*arguments),
+  )
   with pytest.warns(UserWarning, match="configuration2-closed.*unreadable saved scores"):
     assert continual.run_seed(0, tiny) == expected
   assert ran == ["spiral"]

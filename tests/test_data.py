@@ -48,8 +48,9 @@ def partial_folder(collected_config: dict) -> pathlib.Path:
 
 
 def small_config() -> dict:
-  return data.generating_config(SMALL["robot"], SMALL["samples"], SMALL["seed"],
-                                SMALL["episode_length"])
+  return data.generating_config(
+    SMALL["robot"], SMALL["samples"], SMALL["seed"], SMALL["episode_length"]
+  )
 
 
 @pytest.fixture(scope="module")
@@ -91,7 +92,8 @@ def test_layout_and_time_convention():
   for episode in range(collected.num_episodes):
     poses, actions = collected.episode(episode)
     expected_actions = data.rng(SMALL["seed"], data.BABBLING_STREAM, episode).uniform(
-        -1, 1, actions.shape)
+      -1, 1, actions.shape
+    )
     np.testing.assert_array_equal(actions, expected_actions)
     # Pose s before action s: the episode replayed alone from rest gives the same poses.
     expected_poses, _ = pose_recorder.record(actions[None])
@@ -125,10 +127,10 @@ def test_config_hash_covers_the_physics():
 
 def test_random_streams_are_independent_and_reproducible():
   draw = lambda *key: data.rng(*key).uniform(size=5)
-  np.testing.assert_array_equal(draw(0, data.BABBLING_STREAM, 1),
-                                draw(0, data.BABBLING_STREAM, 1))
-  assert not np.array_equal(draw(0, data.BABBLING_STREAM, 0),
-                            draw(0, data.HELD_OUT_BABBLING_STREAM, 0))
+  np.testing.assert_array_equal(draw(0, data.BABBLING_STREAM, 1), draw(0, data.BABBLING_STREAM, 1))
+  assert not np.array_equal(
+    draw(0, data.BABBLING_STREAM, 0), draw(0, data.HELD_OUT_BABBLING_STREAM, 0)
+  )
   assert not np.array_equal(draw(0, data.BABBLING_STREAM, 0), draw(0, data.BABBLING_STREAM, 1))
 
 
@@ -154,7 +156,9 @@ def test_interrupted_collection_resumes_to_identical_bytes(monkeypatch, referenc
     with pytest.raises(KeyboardInterrupt):
       collect()
   assert sorted(path.name for path in partial_folder(small_config()).iterdir()) == [
-      "chunk-000000-000002.npz", "chunk-000002-000004.npz"]
+    "chunk-000000-000002.npz",
+    "chunk-000002-000004.npz",
+  ]
   resumed = collect()
   assert resumed.collection["resumed_from_step"] == 2 * CHUNK
   assert npz_bytes(resumed) == reference_bytes
@@ -172,7 +176,7 @@ def test_corrupt_chunk_is_reported_and_recomputed(monkeypatch, reference_bytes, 
   if damage == "flip":
     content[len(content) // 2] ^= 0xFF
   else:
-    content = content[:len(content) // 2]
+    content = content[: len(content) // 2]
   second.write_bytes(bytes(content))
   with pytest.warns(data.CorruptFileWarning, match="chunk-000002-000004.npz"):
     resumed = collect()
@@ -187,8 +191,9 @@ def test_a_chunk_of_another_collection_is_refused(monkeypatch, reference_bytes):
     interrupt_after(patch, chunk_count=1)
     with pytest.raises(KeyboardInterrupt):
       collect(seed=4)
-  foreign_config = data.generating_config(SMALL["robot"], SMALL["samples"], 4,
-                                          SMALL["episode_length"])
+  foreign_config = data.generating_config(
+    SMALL["robot"], SMALL["samples"], 4, SMALL["episode_length"]
+  )
   (foreign,) = (dataset.dataset_folder(foreign_config) / chunks.PARTIAL_FOLDER).iterdir()
   partial_folder(small_config()).mkdir(parents=True)
   (partial_folder(small_config()) / foreign.name).write_bytes(foreign.read_bytes())
@@ -251,8 +256,9 @@ def _truncate_npz(folder):
 def _truncate_npz_and_rehash(folder):
   """A truncated npz whose manifest was updated to match: numpy's reader must fail cleanly."""
   _truncate_npz(folder)
-  _edit_manifest(folder, npz_sha256=hashlib.sha256(
-      (folder / dataset.NPZ_NAME).read_bytes()).hexdigest())
+  _edit_manifest(
+    folder, npz_sha256=hashlib.sha256((folder / dataset.NPZ_NAME).read_bytes()).hexdigest()
+  )
 
 
 def _edit_manifest(folder, **fields):
@@ -286,14 +292,16 @@ def _other_seed_manifest(folder):
     (folder / name).write_bytes((other.path / name).read_bytes())
 
 
-DAMAGES = {"npz byte flip": (_flip_npz, dataset.NPZ_NAME),
-           "truncated npz": (_truncate_npz, dataset.NPZ_NAME),
-           "truncated npz, rehashed": (_truncate_npz_and_rehash, dataset.NPZ_NAME),
-           "missing npz": (_remove_npz, dataset.NPZ_NAME),
-           "edited config": (_edit_config, dataset.JSON_NAME),
-           "edited arrays hash": (_edit_arrays_hash, dataset.NPZ_NAME),
-           "truncated json": (_truncate_json, dataset.JSON_NAME),
-           "files of another seed": (_other_seed_manifest, dataset.JSON_NAME)}
+DAMAGES = {
+  "npz byte flip": (_flip_npz, dataset.NPZ_NAME),
+  "truncated npz": (_truncate_npz, dataset.NPZ_NAME),
+  "truncated npz, rehashed": (_truncate_npz_and_rehash, dataset.NPZ_NAME),
+  "missing npz": (_remove_npz, dataset.NPZ_NAME),
+  "edited config": (_edit_config, dataset.JSON_NAME),
+  "edited arrays hash": (_edit_arrays_hash, dataset.NPZ_NAME),
+  "truncated json": (_truncate_json, dataset.JSON_NAME),
+  "files of another seed": (_other_seed_manifest, dataset.JSON_NAME),
+}
 
 
 @pytest.mark.parametrize("damage", DAMAGES)
@@ -302,8 +310,9 @@ def test_damaged_dataset_raises_one_line_dataset_error(damage):
   damage_files, named_file = DAMAGES[damage]
   damage_files(collected.path)
   with pytest.raises(data.DatasetError) as raised:
-    data.load(SMALL["robot"], SMALL["samples"], SMALL["seed"],
-              episode_length=SMALL["episode_length"])
+    data.load(
+      SMALL["robot"], SMALL["samples"], SMALL["seed"], episode_length=SMALL["episode_length"]
+    )
   message = str(raised.value)
   assert "\n" not in message and named_file in message, message
 
@@ -319,9 +328,20 @@ def test_load_of_an_uncollected_dataset_raises_dataset_error():
     data.load("tendon-1", samples=5)
 
 
-@pytest.mark.parametrize("arguments", [
-    {"robot": "tendon-0"}, {"robot": "octopus-8"}, {"samples": 0}, {"samples": 2.5},
-    {"workers": 0}, {"seed": -1}, {"seed": 1.5}, {"episode_length": 0}, {"chunk_length": 0}])
+@pytest.mark.parametrize(
+  "arguments",
+  [
+    {"robot": "tendon-0"},
+    {"robot": "octopus-8"},
+    {"samples": 0},
+    {"samples": 2.5},
+    {"workers": 0},
+    {"seed": -1},
+    {"seed": 1.5},
+    {"episode_length": 0},
+    {"chunk_length": 0},
+  ],
+)
 def test_bad_arguments_raise_one_line_value_error(arguments):
   with pytest.raises(ValueError) as raised:
     collect(**arguments)
@@ -345,17 +365,22 @@ def test_split_pieces_are_contiguous_disjoint_and_70_10_20(lengths):
   pieces = data.split_pieces(lengths)
   flat = [(split, piece) for split in data.SPLITS for piece in pieces[split]]
   # In recording order, each piece starts where the one before stopped, or at a new episode.
-  covered = [(piece.episode, sample) for _, piece in flat
-             for sample in range(piece.start, piece.stop)]
-  assert covered == [(episode, sample) for episode, length in enumerate(lengths)
-                     for sample in range(length)]
+  covered = [
+    (piece.episode, sample) for _, piece in flat for sample in range(piece.start, piece.stop)
+  ]
+  assert covered == [
+    (episode, sample) for episode, length in enumerate(lengths) for sample in range(length)
+  ]
   total = sum(lengths)
   for split, fraction in zip(data.SPLITS, data.FRACTIONS):
     assert abs(sum(piece.samples for piece in pieces[split]) - fraction * total) <= 1
     assert len({piece.episode for piece in pieces[split]}) == len(pieces[split])
   if lengths == (1400,) * 10:
     assert [[piece.episode for piece in pieces[split]] for split in data.SPLITS] == [
-        list(range(7)), [7], [8, 9]]
+      list(range(7)),
+      [7],
+      [8, 9],
+    ]
     assert all(piece.samples == 1400 for _, piece in flat)
 
 
@@ -375,8 +400,9 @@ def test_normaliser_round_trip_and_constant_features():
 
 
 def _views(arm):
-  return ([data.View.end_effector(arm), data.View.whole_arm(arm)]
-          + [data.View.module(arm, module) for module in range(1, arm.num_modules + 1)])
+  return [data.View.end_effector(arm), data.View.whole_arm(arm)] + [
+    data.View.module(arm, module) for module in range(1, arm.num_modules + 1)
+  ]
 
 
 @pytest.mark.parametrize("robot_name", robots.BENCHMARK_ROBOTS)
@@ -388,7 +414,7 @@ def test_view_sizes_for_every_robot(robot_name):
   for module, view in enumerate(modules, start=1):
     assert view.pose_modules == (module - 1,)
     assert view.action_size == arm.actuators_per_module[module - 1]
-    assert view.preceding_action_size == sum(arm.actuators_per_module[:module - 1])
+    assert view.preceding_action_size == sum(arm.actuators_per_module[: module - 1])
   with pytest.raises(ValueError):
     data.View.module(arm, arm.num_modules + 1)
 
@@ -403,7 +429,10 @@ def test_window_shapes_for_every_robot(robot_name):
       assert windows.poses.dtype == torch.float32
       assert windows.steps == 1
       assert (windows.pose_size, windows.action_size, windows.preceding_actions.shape[2]) == (
-          view.pose_size, view.action_size, view.preceding_action_size)
+        view.pose_size,
+        view.action_size,
+        view.preceding_action_size,
+      )
 
 
 def _split_recordings(collected, view, split):
@@ -423,20 +452,27 @@ def test_windows_are_consecutive_rows_of_one_piece(windowed, module):
     expected_count = sum(max(0, len(actions) - steps) for _, actions, _ in recordings)
     assert len(windows) == expected_count > 0
     for index in range(len(windows)):
-      assert any(_window_in(windows, index, recording, fitted, steps)
-                 for recording in recordings), (split, index)
+      assert any(
+        _window_in(windows, index, recording, fitted, steps) for recording in recordings
+      ), (split, index)
 
 
 def _window_in(windows, index, recording, fitted, steps) -> bool:
-  poses, actions, preceding = (np.float32(normaliser.normalise(values)) for normaliser, values
-                               in zip((fitted.poses, fitted.actions, fitted.preceding_actions),
-                                      recording))
-  window = [part[index].numpy() for part in (windows.poses, windows.actions,
-                                             windows.preceding_actions)]
+  poses, actions, preceding = (
+    np.float32(normaliser.normalise(values))
+    for normaliser, values in zip(
+      (fitted.poses, fitted.actions, fitted.preceding_actions), recording
+    )
+  )
+  window = [
+    part[index].numpy() for part in (windows.poses, windows.actions, windows.preceding_actions)
+  ]
   for start in range(len(actions) - steps):  # x_{-1} is poses[start].
-    if (np.array_equal(window[0], poses[start:start + steps + 2])
-        and np.array_equal(window[1], actions[start + 1:start + steps + 1])
-        and np.array_equal(window[2], preceding[start + 1:start + steps + 1])):
+    if (
+      np.array_equal(window[0], poses[start : start + steps + 2])
+      and np.array_equal(window[1], actions[start + 1 : start + steps + 1])
+      and np.array_equal(window[2], preceding[start + 1 : start + steps + 1])
+    ):
       return True
   return False
 
@@ -446,16 +482,19 @@ def test_normalisation_is_fitted_on_the_training_split_only(windowed):
   split_windows = data.windows(windowed, view)
   fitted = split_windows.normalisation
   for part, normaliser in enumerate((fitted.poses, fitted.actions)):
-    train = np.concatenate([recording[part] for recording in
-                            _split_recordings(windowed, view, "train")])
+    train = np.concatenate(
+      [recording[part] for recording in _split_recordings(windowed, view, "train")]
+    )
     np.testing.assert_array_equal(normaliser.minimum, train.min(axis=0))
     np.testing.assert_array_equal(normaliser.maximum, train.max(axis=0))
   assert split_windows.train.poses.abs().max() <= 1.0 + 1e-6
   assert split_windows.test.poses.abs().max() > 1.0  # Test poses outside the training range.
   arrays = fitted.to_arrays()
-  assert sorted(arrays) == sorted(f"{field}_{stat}" for field in
-                                  ("poses", "actions", "preceding_actions")
-                                  for stat in ("minimum", "maximum"))
+  assert sorted(arrays) == sorted(
+    f"{field}_{stat}"
+    for field in ("poses", "actions", "preceding_actions")
+    for stat in ("minimum", "maximum")
+  )
   restored = data.Normalisation.from_arrays(arrays)
   poses = windowed.poses.reshape(len(windowed.poses), -1)
   np.testing.assert_array_equal(restored.poses.normalise(poses), fitted.poses.normalise(poses))
@@ -482,8 +521,9 @@ def test_every_cache_file_gets_the_permissions_of_a_plain_open(tmp_path, monkeyp
   plain.write_text("x")
   agents.make("mlp", "tendon-1", 0, "tiny")
   files = [path for path in (tmp_path / "home").rglob("*") if path.is_file()]
-  assert {"checkpoints", "forward", "datasets"} <= {path.relative_to(tmp_path / "home").parts[0]
-                                                     for path in files}
+  assert {"checkpoints", "forward", "datasets"} <= {
+    path.relative_to(tmp_path / "home").parts[0] for path in files
+  }
   assert {path.stat().st_mode for path in files} == {plain.stat().st_mode}
 
 

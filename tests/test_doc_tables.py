@@ -3,7 +3,6 @@
 scores hides outside a block, and ``softbench leaderboard --write`` rewrites the blocks."""
 
 import pathlib
-import re
 import shutil
 
 import pytest
@@ -16,9 +15,9 @@ ROOT = pathlib.Path(__file__).parent.parent
 RESULTS = ROOT / "leaderboard" / "results"
 # Tables of one-off measurements that no record holds (each page names the script or commit).
 ONE_OFF_TABLE_HEADERS = (
-    "| helpers |",  # docs/paper-comparison.md: reach with the other helper convention.
-    "| robot, fault |",  # docs/faults.md: records of the fault experiment, in docs/faults/.
-    "| stage |",  # docs/adaptive-activation.md: adaptive activation per stage.
+  "| helpers |",  # docs/paper-comparison.md: reach with the other helper convention.
+  "| robot, fault |",  # docs/faults.md: records of the fault experiment, in docs/faults/.
+  "| stage |",  # docs/adaptive-activation.md: adaptive activation per stage.
 )
 EXP1S_RECORD = "smpl-exp1s-default-2026-11-24T041101Z.json"
 
@@ -46,7 +45,8 @@ def test_the_pages_are_the_readme_and_the_docs(pages):
 def test_every_block_is_known_and_equals_what_the_records_give(pages, board):
   for page, text in pages.items():
     assert doc_tables.stale_blocks(text, board, str(page)) == [], (
-        f"{page}: out of date; run softbench leaderboard --write")
+      f"{page}: out of date; run softbench leaderboard --write"
+    )
 
 
 def test_every_named_table_appears_in_the_docs(pages):
@@ -66,7 +66,8 @@ def test_no_typed_table_of_scores_outside_the_blocks(pages):
       header = header or line.strip()
       if number not in inside and " ± " in line:
         assert header.startswith(ONE_OFF_TABLE_HEADERS), (
-            f"{page}:{number + 1}: a typed table of scores; generate it (doc_tables.TABLES)")
+          f"{page}:{number + 1}: a typed table of scores; generate it (doc_tables.TABLES)"
+        )
 
 
 def test_an_unknown_table_fails(board):
@@ -76,11 +77,14 @@ def test_an_unknown_table_fails(board):
     doc_tables.render("no-such", board)
 
 
-@pytest.mark.parametrize("text,message", [
+@pytest.mark.parametrize(
+  "text,message",
+  [
     (_block("headline-spiral").removesuffix("<!-- /softbench:table -->\n"), "never closed"),
     ("<!-- /softbench:table -->\n", "without an opening marker"),
     (_block("headline-spiral", "<!-- softbench:table headline-spiral -->\n"), "inside block"),
-])
+  ],
+)
 def test_a_malformed_block_fails(text, message):
   with pytest.raises(doc_tables.DocTableError, match=message):
     doc_tables.blocks(text)
@@ -101,8 +105,9 @@ def test_an_out_of_date_block_fails_and_rewriting_mends_it(pages, board):
 def test_the_tables_use_the_records_population_std(board):
   # pneumatic-433 SMPL, paper profile, spiral: std over the 5 seeds with ddof 0 is 0.30 (ddof 1:
   # 0.34, which a typed table once showed).
-  smpl = ("| smpl | 11.48 ± 0.31 (4.97) | 2.81 ± 0.35 (2.77) | 2.91 ± 0.34 (2.38) | "
-          "2.58 ± 0.30 (3.02) |")
+  smpl = (
+    "| smpl | 11.48 ± 0.31 (4.97) | 2.81 ± 0.35 (2.77) | 2.91 ± 0.34 (2.38) | 2.58 ± 0.30 (3.02) |"
+  )
   assert smpl in doc_tables.render("overview-pneumatic-433-paper", board)
 
 
@@ -113,11 +118,15 @@ def test_leaderboard_write_rewrites_the_blocks_of_the_checkout(tmp_path, capsys)
   (tmp_path / "docs").mkdir()
   stale = "# Exp1S\n\n" + _block("exp1s-tendon-default", "| typed | 1.00 ± 0.10 |\n") + "\nEnd.\n"
   untouched = "# No tables\n"
-  for path, text in ((tmp_path / "README.md", stale), (tmp_path / "docs" / "exp1s.md", stale),
-                     (tmp_path / "docs" / "other.md", untouched)):
+  for path, text in (
+    (tmp_path / "README.md", stale),
+    (tmp_path / "docs" / "exp1s.md", stale),
+    (tmp_path / "docs" / "other.md", untouched),
+  ):
     path.write_text(text)
-  cli.main(["leaderboard", "--results", str(results), "--write", "--out",
-            str(tmp_path / "leaderboard")])
+  cli.main(
+    ["leaderboard", "--results", str(results), "--write", "--out", str(tmp_path / "leaderboard")]
+  )
   board = leaderboard.build(results)
   expected = doc_tables.rewrite(stale, board)
   assert "20.00 ± 5.24 (1.49)" in expected and "typed" not in expected
@@ -128,8 +137,9 @@ def test_leaderboard_write_rewrites_the_blocks_of_the_checkout(tmp_path, capsys)
   assert f"wrote {tmp_path / 'README.md'}" in printed
   assert f"wrote {tmp_path / 'docs' / 'other.md'}" not in printed
   # Up to date: nothing is written again.
-  cli.main(["leaderboard", "--results", str(results), "--write", "--out",
-            str(tmp_path / "leaderboard")])
+  cli.main(
+    ["leaderboard", "--results", str(results), "--write", "--out", str(tmp_path / "leaderboard")]
+  )
   assert "README.md" not in capsys.readouterr().out.replace("leaderboard/README.md", "")
 
 

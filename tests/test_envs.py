@@ -8,13 +8,13 @@ import sys
 import warnings
 
 import gymnasium
+from gymnasium.utils import env_checker
 import numpy as np
 import pytest
-from gymnasium.utils import env_checker
 
-import softbench.envs
 from softbench import robots
 from softbench import suite
+import softbench.envs
 from softbench.envs import environment
 from softbench.robots import faults
 from softbench.suite import references
@@ -24,6 +24,8 @@ SHORT_STEPS = 3  # Control steps of every shortened episode (as in test_suite: s
 
 def short(task: str) -> dict:
   return suite.length_options(task, SHORT_STEPS)
+
+
 BENCHMARK_PAIRS = suite.ALL_TASKS
 
 
@@ -78,13 +80,18 @@ def test_a_seed_starts_the_episode_the_suite_starts_with_that_seed(robot, task):
 @pytest.mark.parametrize("robot,task", BENCHMARK_PAIRS)
 def test_two_async_environments_step_in_subprocesses(robot, task):
   env_id = softbench.envs.env_id(robot, task)
-  vector = gymnasium.make_vec(env_id, num_envs=2, vectorization_mode="async",
-                              **{**short(task), "initial_actuation": 0.0})
+  vector = gymnasium.make_vec(
+    env_id, num_envs=2, vectorization_mode="async", **{**short(task), "initial_actuation": 0.0}
+  )
   try:
     observations, _ = vector.reset(seed=3)
     assert observations.shape == (2, *vector.single_observation_space.shape)
-    actions = np.stack([np.full(vector.single_action_space.shape, 0.5, np.float32),
-                        np.full(vector.single_action_space.shape, -0.5, np.float32)])
+    actions = np.stack(
+      [
+        np.full(vector.single_action_space.shape, 0.5, np.float32),
+        np.full(vector.single_action_space.shape, -0.5, np.float32),
+      ]
+    )
     stepped, rewards, terminated, truncated, _ = vector.step(actions)
     assert stepped.shape == observations.shape and np.all(np.isfinite(stepped))
     assert np.all((rewards >= 0) & (rewards <= 1)) and not terminated.any()
@@ -121,8 +128,9 @@ def test_custom_follows_the_trajectory_given_to_make():
   targets = references.reference(arm, "circle", 3).targets
   env = gymnasium.make(softbench.envs.env_id("tendon-2", "custom"), trajectory=targets)
   observation, _ = env.reset(seed=0)
-  np.testing.assert_array_equal(observation[env.unwrapped.observation_layout["target"]],
-                                targets[0].ravel())
+  np.testing.assert_array_equal(
+    observation[env.unwrapped.observation_layout["target"]], targets[0].ravel()
+  )
 
 
 def test_any_robot_and_fault_through_the_generic_id():
@@ -152,22 +160,35 @@ def test_rgb_array_frames_show_the_arm_headlessly(robot):
   env.close()
 
 
-@pytest.mark.parametrize("make_env,message", [
+@pytest.mark.parametrize(
+  "make_env,message",
+  [
     (lambda: gymnasium.make("softbench/tendon-3-spiral-v0", lenght=3), "no option 'lenght'"),
     (lambda: gymnasium.make("softbench/tendon-3-custom-v0"), "needs a trajectory"),
     (lambda: gymnasium.make("softbench/tendon-3-reach-v0", module=4), "module must be 1 to 3"),
-    (lambda: gymnasium.make("softbench/tendon-3-reach-v0", observation="image"),
-     "observation must be one of flat, dict"),
-    (lambda: environment.SoftArmEnv("tendon-3", "reach", render_mode="ansi"),
-     "render_mode must be None or one of rgb_array"),
+    (
+      lambda: gymnasium.make("softbench/tendon-3-reach-v0", observation="image"),
+      "observation must be one of flat, dict",
+    ),
+    (
+      lambda: environment.SoftArmEnv("tendon-3", "reach", render_mode="ansi"),
+      "render_mode must be None or one of rgb_array",
+    ),
     (lambda: gymnasium.make("softbench/tendon-3-reach-v0", width=64), "need render_mode"),
-    (lambda: gymnasium.make("softbench/tendon-3-reach-v0", render_mode="rgb_array", width=7),
-     "width must be an even number"),
-    (lambda: gymnasium.make(softbench.envs.ANY_ROBOT_ID, robot="tendon-03", task="reach"),
-     "tendon-03"),
-    (lambda: gymnasium.make(softbench.envs.ANY_ROBOT_ID, robot="tendon-3", task="wave"),
-     "unknown task 'wave'"),
-])
+    (
+      lambda: gymnasium.make("softbench/tendon-3-reach-v0", render_mode="rgb_array", width=7),
+      "width must be an even number",
+    ),
+    (
+      lambda: gymnasium.make(softbench.envs.ANY_ROBOT_ID, robot="tendon-03", task="reach"),
+      "tendon-03",
+    ),
+    (
+      lambda: gymnasium.make(softbench.envs.ANY_ROBOT_ID, robot="tendon-3", task="wave"),
+      "unknown task 'wave'",
+    ),
+  ],
+)
 def test_bad_options_get_one_line_errors(make_env, message):
   with pytest.raises(ValueError, match=message) as error:
     make_env()
@@ -193,16 +214,18 @@ def test_render_before_reset_and_step_before_reset_are_clear_errors():
 
 
 def test_the_physics_side_and_the_environments_import_without_torch():
-  code = ("import sys, softbench.suite, softbench.robots, softbench.rendering.video, "
-          "softbench.rendering.live, softbench.envs; print('torch' in sys.modules)")
-  result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                          check=True)
+  code = (
+    "import sys, softbench.suite, softbench.robots, softbench.rendering.video, "
+    "softbench.rendering.live, softbench.envs; print('torch' in sys.modules)"
+  )
+  result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
   assert result.stdout.strip() == "False"
 
 
 def test_a_make_without_importing_softbench_uses_the_module_form():
-  code = ("import gymnasium; env = gymnasium.make('softbench.envs:softbench/tendon-1-reach-v0', "
-          "steps=1); print(env.reset(seed=0)[0].shape)")
-  result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                          check=True)
+  code = (
+    "import gymnasium; env = gymnasium.make('softbench.envs:softbench/tendon-1-reach-v0', "
+    "steps=1); print(env.reset(seed=0)[0].shape)"
+  )
+  result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
   assert result.stdout.strip() == "(11,)"  # tendon-1: one pose (6), the point (3), 2 cables.

@@ -31,8 +31,13 @@ ROBOTS = tuple(f"tendon-{n}" for n in range(1, 6))
 DATE = "2026-01-02T03:04:05+00:00"
 
 
-def exp1s_record(seeds: int = 2, profile: str = "tiny", date: str = DATE,
-                 robot_names: tuple[str, ...] = ROBOTS, scale: float = 1.0) -> dict:
+def exp1s_record(
+  seeds: int = 2,
+  profile: str = "tiny",
+  date: str = DATE,
+  robot_names: tuple[str, ...] = ROBOTS,
+  scale: float = 1.0,
+) -> dict:
   """An unsealed Exp1S record with errors drawn per seed and configuration (times ``scale``)."""
   rng = np.random.default_rng(seeds)
   lengths_mm = {name: robots.make(name).length * metrics.MM_PER_M for name in robot_names}
@@ -44,24 +49,45 @@ def exp1s_record(seeds: int = 2, profile: str = "tiny", date: str = DATE,
       for task in continual.TASKS:
         for name in robot_names:
           position = float(rng.uniform(0.1, 10.0)) * scale
-          scores[loop][task].append({
-              "position_mm": position, "orientation_deg": float(rng.uniform(0.1, 5.0)),
-              "normalised_tip_percent": position / lengths_mm[name] * metrics.PERCENT})
+          scores[loop][task].append(
+            {
+              "position_mm": position,
+              "orientation_deg": float(rng.uniform(0.1, 5.0)),
+              "normalised_tip_percent": position / lengths_mm[name] * metrics.PERCENT,
+            }
+          )
     tip = [entry["normalised_tip_percent"] for entry in scores["closed"][continual.FORGETTING_TASK]]
     model = [float(value) for value in rng.uniform(1e-4, 1e-2, size)]
-    per_seed.append({
-        "seed": seed, "scores": scores,
-        "forgetting_model_pose_mse": [[model[c] if c <= s else None for c in range(size)]
-                                      for s in range(size)],
-        "forgetting_tip_percent": [[tip[c] if c <= s else None for c in range(size)]
-                                   for s in range(size)]})
+    per_seed.append(
+      {
+        "seed": seed,
+        "scores": scores,
+        "forgetting_model_pose_mse": [
+          [model[c] if c <= s else None for c in range(size)] for s in range(size)
+        ],
+        "forgetting_tip_percent": [
+          [tip[c] if c <= s else None for c in range(size)] for s in range(size)
+        ],
+      }
+    )
   settings = profiles.get(profile)
-  return {"format": continual.RECORD_FORMAT, "version": continual.RECORD_VERSION,
-          "softbench_version": "0.1.0", "git_commit": None, "date": date,
-          "machine": {"platform": "test"}, "protocol": continual.PROTOCOL, "agent": "smpl",
-          "robots": list(robot_names), "tasks": list(continual.TASKS), "profile": profile,
-          "profile_settings": {"name": settings.name, "samples": settings.samples},
-          "seeds": seeds, "per_seed": per_seed, "wall_time_s": 12.5}
+  return {
+    "format": continual.RECORD_FORMAT,
+    "version": continual.RECORD_VERSION,
+    "softbench_version": "0.1.0",
+    "git_commit": None,
+    "date": date,
+    "machine": {"platform": "test"},
+    "protocol": continual.PROTOCOL,
+    "agent": "smpl",
+    "robots": list(robot_names),
+    "tasks": list(continual.TASKS),
+    "profile": profile,
+    "profile_settings": {"name": settings.name, "samples": settings.samples},
+    "seeds": seeds,
+    "per_seed": per_seed,
+    "wall_time_s": 12.5,
+  }
 
 
 def write_raw(record: dict, path: pathlib.Path, reseal: bool = True) -> pathlib.Path:
@@ -102,6 +128,7 @@ def _set(path, value):
       del target[last]
     else:
       target[last] = value
+
   return change
 
 
@@ -145,49 +172,87 @@ def _forgetting_task_dropped(record):
 
 
 MALFORMED = {
-    "hand-edited number": (_edit_number, False, "does not match its sha256"),
-    "old version": (_set(["version"], 1), True,
-                    "record version 1 is not read: it has no integrity hash"),
-    "newer version": (_set(["version"], 3), True, "this softbench reads version 2"),
-    "NaN": (_set(["per_seed", 0, "scores", "closed", "spiral", 0, "position_mm"], math.nan),
-            False, "position_mm: nan is not a finite number"),
-    "negative error": (_set(["per_seed", 1, "scores", "open", "circle", 0, "orientation_deg"],
-                            -1.0), True, "-1.0 is less than the minimum of 0"),
-    "integer beyond floats": (_set(["per_seed", 0, "scores", "closed", "spiral", 0,
-                                    "position_mm"], 10**400), True,
-                              "is greater than the maximum of 1000000"),
-    "astronomical matrix entry": (_set(["per_seed", 0, "forgetting_model_pose_mse", 0, 0],
-                                       1e300), True, r"1e\+300 is greater than the maximum"),
-    "missing metric": (_set(["per_seed", 0, "scores", "closed", "circle", 0, "orientation_deg"],
-                            None), True, "'orientation_deg' is a required property"),
-    "unknown task": (_set(["tasks"], ["babbling", "juggle"]), True, "'juggle' is not one of"),
-    "unknown loop": (_set(["per_seed", 0, "scores", "sideways"], {}), True, "sideways"),
-    "unknown profile": (_set(["profile"], "huge"), True, "'huge' is not one of"),
-    "profile settings": (_set(["profile_settings", "name"], "paper"), True,
-                         "is not the profile 'tiny'"),
-    "unknown robot": (_set(["robots"], ["tendon-0", *ROBOTS[1:]]), True,
-                      r"robots\[0\]: 'tendon-0' does not match"),
-    "loose robot name": (_set(["robots"], ["tendon-01", *ROBOTS[1:]]), True,
-                         r"robots\[0\]: 'tendon-01' does not match"),
-    "other protocol": (_set(["protocol"], "exp2s"), True, "'exp1s' was expected"),
-    "extra scalar field": (_set(["score"], 3), True, "score: unknown field"),
-    "seed count": (_set(["seeds"], 3), True, "seeds is 3 but per_seed has 2 entries"),
-    "repeated seed": (_set(["per_seed", 1, "seed"], 0), True, "repeats a seed"),
-    "configuration missing": (_drop_configuration, True,
-                              r"per_seed\[1\].scores.closed.rectangle has 4 entries for 5 "
-                              r"configurations"),
-    "task missing": (_drop_task, True, r"per_seed\[0\].scores.open has tasks"),
-    "tip error": (_tip_not_from_position, True,
-                  r"scores.open.babbling\[1\]: normalised_tip_percent .* is not position_mm / "
-                  r"tendon-2's length"),
-    "matrix not square": (_not_square, True, "forgetting_tip_percent is not 5 x 5"),
-    "number above the diagonal": (_number_above_diagonal, True,
-                                  r"forgetting_model_pose_mse\[0\]\[3\] is 0.5; null expected"),
-    "null on the diagonal": (_null_on_diagonal, True,
-                             r"forgetting_tip_percent\[2\]\[2\] is None; a number expected"),
-    "forgetting row": (_last_row_differs, True, "last row .* is not the closed-loop spiral"),
-    "forgetting task": (_forgetting_task_dropped, True, "lack spiral"),
-    "date": (_set(["date"], "yesterday"), True, "not an ISO 8601 date"),
+  "hand-edited number": (_edit_number, False, "does not match its sha256"),
+  "old version": (
+    _set(["version"], 1),
+    True,
+    "record version 1 is not read: it has no integrity hash",
+  ),
+  "newer version": (_set(["version"], 3), True, "this softbench reads version 2"),
+  "NaN": (
+    _set(["per_seed", 0, "scores", "closed", "spiral", 0, "position_mm"], math.nan),
+    False,
+    "position_mm: nan is not a finite number",
+  ),
+  "negative error": (
+    _set(["per_seed", 1, "scores", "open", "circle", 0, "orientation_deg"], -1.0),
+    True,
+    "-1.0 is less than the minimum of 0",
+  ),
+  "integer beyond floats": (
+    _set(["per_seed", 0, "scores", "closed", "spiral", 0, "position_mm"], 10**400),
+    True,
+    "is greater than the maximum of 1000000",
+  ),
+  "astronomical matrix entry": (
+    _set(["per_seed", 0, "forgetting_model_pose_mse", 0, 0], 1e300),
+    True,
+    r"1e\+300 is greater than the maximum",
+  ),
+  "missing metric": (
+    _set(["per_seed", 0, "scores", "closed", "circle", 0, "orientation_deg"], None),
+    True,
+    "'orientation_deg' is a required property",
+  ),
+  "unknown task": (_set(["tasks"], ["babbling", "juggle"]), True, "'juggle' is not one of"),
+  "unknown loop": (_set(["per_seed", 0, "scores", "sideways"], {}), True, "sideways"),
+  "unknown profile": (_set(["profile"], "huge"), True, "'huge' is not one of"),
+  "profile settings": (
+    _set(["profile_settings", "name"], "paper"),
+    True,
+    "is not the profile 'tiny'",
+  ),
+  "unknown robot": (
+    _set(["robots"], ["tendon-0", *ROBOTS[1:]]),
+    True,
+    r"robots\[0\]: 'tendon-0' does not match",
+  ),
+  "loose robot name": (
+    _set(["robots"], ["tendon-01", *ROBOTS[1:]]),
+    True,
+    r"robots\[0\]: 'tendon-01' does not match",
+  ),
+  "other protocol": (_set(["protocol"], "exp2s"), True, "'exp1s' was expected"),
+  "extra scalar field": (_set(["score"], 3), True, "score: unknown field"),
+  "seed count": (_set(["seeds"], 3), True, "seeds is 3 but per_seed has 2 entries"),
+  "repeated seed": (_set(["per_seed", 1, "seed"], 0), True, "repeats a seed"),
+  "configuration missing": (
+    _drop_configuration,
+    True,
+    r"per_seed\[1\].scores.closed.rectangle has 4 entries for 5 "
+    r"configurations",
+  ),
+  "task missing": (_drop_task, True, r"per_seed\[0\].scores.open has tasks"),
+  "tip error": (
+    _tip_not_from_position,
+    True,
+    r"scores.open.babbling\[1\]: normalised_tip_percent .* is not position_mm / "
+    r"tendon-2's length",
+  ),
+  "matrix not square": (_not_square, True, "forgetting_tip_percent is not 5 x 5"),
+  "number above the diagonal": (
+    _number_above_diagonal,
+    True,
+    r"forgetting_model_pose_mse\[0\]\[3\] is 0.5; null expected",
+  ),
+  "null on the diagonal": (
+    _null_on_diagonal,
+    True,
+    r"forgetting_tip_percent\[2\]\[2\] is None; a number expected",
+  ),
+  "forgetting row": (_last_row_differs, True, "last row .* is not the closed-loop spiral"),
+  "forgetting task": (_forgetting_task_dropped, True, "lack spiral"),
+  "date": (_set(["date"], "yesterday"), True, "not an ISO 8601 date"),
 }
 
 
@@ -248,12 +313,12 @@ def results(run_record, tmp_path) -> pathlib.Path:
   profile default, a two-configuration one, and one with an extra section."""
   folder = tmp_path / "results"
   made = {
-      "exp1s-tiny-old.json": exp1s_record(date="2025-01-01T00:00:00+00:00", scale=0.5),
-      "exp1s-tiny.json": exp1s_record(),
-      "exp1s-default.json": exp1s_record(seeds=3, profile="default", scale=2.0),
-      "exp1s-two.json": exp1s_record(robot_names=ROBOTS[:2]),
-      "exp1s-fault.json": {**exp1s_record(), "fault": {"module": 1}},
-      "run.json": run_record,
+    "exp1s-tiny-old.json": exp1s_record(date="2025-01-01T00:00:00+00:00", scale=0.5),
+    "exp1s-tiny.json": exp1s_record(),
+    "exp1s-default.json": exp1s_record(seeds=3, profile="default", scale=2.0),
+    "exp1s-two.json": exp1s_record(robot_names=ROBOTS[:2]),
+    "exp1s-fault.json": {**exp1s_record(), "fault": {"module": 1}},
+    "run.json": run_record,
   }
   for name, record in made.items():
     records.write(record, folder / name)
@@ -265,8 +330,11 @@ def test_exp1s_grouping(results):
   assert board.record_count == 6
   assert [group.title for group in board.groups] == ["tendon-1 · circle"]
   titles = [group.title for group in board.exp1s]
-  assert titles == ["Exp1S · tendon-1, tendon-2", f"Exp1S · {', '.join(ROBOTS)}",
-                    f"Exp1S · {', '.join(ROBOTS)} (with fault)"]
+  assert titles == [
+    "Exp1S · tendon-1, tendon-2",
+    f"Exp1S · {', '.join(ROBOTS)}",
+    f"Exp1S · {', '.join(ROBOTS)} (with fault)",
+  ]
   full = board.exp1s[1]
   assert [entry.path.name for entry in full.entries] == ["exp1s-default.json", "exp1s-tiny.json"]
   assert [entry.path.name for entry in full.superseded] == ["exp1s-tiny-old.json"]
@@ -282,8 +350,10 @@ def test_exp1s_figures(results):
   assert closed.rows[4][column] == f"{np.mean(values):.2f} ± {np.std(values):.2f}"
   assert closed.rows[5][column] == "1.75 ± 0.85"  # The paper: circle, 3 modules, closed loop.
   forgetting = entry.forgetting()
-  spiral = [[seed["scores"]["closed"]["spiral"][c]["normalised_tip_percent"]
-             for seed in record["per_seed"]] for c in range(len(ROBOTS))]
+  spiral = [
+    [seed["scores"]["closed"]["spiral"][c]["normalised_tip_percent"] for seed in record["per_seed"]]
+    for c in range(len(ROBOTS))
+  ]
   assert forgetting[4] == pytest.approx([np.mean(values) for values in spiral], rel=1e-12)
   assert forgetting[1][2:] == [None] * 3
 
@@ -314,16 +384,18 @@ def test_pages_contain_every_exp1s_record(results, tmp_path, capsys):
   assert page.count('<tr class="paper">') == shown_configurations * len(continual.LOOPS)
   high = f"background:#{''.join(f'{c:02x}' for c in html_page._HEAT_HIGH)}"
   matrices = [entry.forgetting() for group in board.exp1s for entry in group.entries]
-  largest = [max(value for row in matrix for value in row if value is not None)
-             for matrix in matrices]
+  largest = [
+    max(value for row in matrix for value in row if value is not None) for matrix in matrices
+  ]
   darkest = sum(row.count(value) for matrix, value in zip(matrices, largest) for row in matrix)
   assert page.count(high) == darkest  # The largest value of each matrix gets the darkest colour.
   assert page.count('<td class="empty"></td>') == sum(len(m) * (len(m) - 1) // 2 for m in matrices)
   assert "<link" not in page and "src=" not in page and "<script src" not in page
 
 
-def test_regenerating_with_exp1s_records_is_deterministic(results, tmp_path,
-                                                          assert_regenerates_identically):
+def test_regenerating_with_exp1s_records_is_deterministic(
+  results, tmp_path, assert_regenerates_identically
+):
   assert_regenerates_identically(results, tmp_path)
 
 

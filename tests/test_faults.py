@@ -66,18 +66,22 @@ def test_a_fault_scales_exactly_its_actuator_and_nothing_else(name):
   qpos, qvel = _bent_state(healthy_model, healthy.action_to_ctrl(rng.uniform(-1, 1, len(action))))
   ctrl, rest = healthy.action_to_ctrl(action), healthy.action_to_ctrl(np.zeros_like(action))
   # The force the action adds (cable tension; bellows pull from its commanded length change).
-  forces = {label: _actuator_forces(model, qpos, qvel, ctrl)
-            - _actuator_forces(model, qpos, qvel, rest)
-            for label, model in (("healthy", healthy_model), ("faulty", faulty_model))}
+  forces = {
+    label: _actuator_forces(model, qpos, qvel, ctrl) - _actuator_forces(model, qpos, qvel, rest)
+    for label, model in (("healthy", healthy_model), ("faulty", faulty_model))
+  }
   for index in range(healthy_model.nu):
     if index in indices:
       assert abs(forces["healthy"][index]) > 1e-3
-      np.testing.assert_allclose(forces["faulty"][index], indices[index] * forces["healthy"][index],
-                                 rtol=1e-9, atol=1e-12)
+      np.testing.assert_allclose(
+        forces["faulty"][index], indices[index] * forces["healthy"][index], rtol=1e-9, atol=1e-12
+      )
     else:
       assert forces["faulty"][index] == forces["healthy"][index]
-  raw = {label: _actuator_forces(model, qpos, qvel, ctrl)
-         for label, model in (("healthy", healthy_model), ("faulty", faulty_model))}
+  raw = {
+    label: _actuator_forces(model, qpos, qvel, ctrl)
+    for label, model in (("healthy", healthy_model), ("faulty", faulty_model))
+  }
   others = [index for index in range(healthy_model.nu) if index not in indices]
   np.testing.assert_array_equal(raw["faulty"][others], raw["healthy"][others])
 
@@ -87,8 +91,9 @@ def test_the_faulty_mjcf_differs_only_in_the_faulty_gains(name):
   healthy = robots.make(name)
   faulty = healthy.with_faults(_test_faults(healthy))
   healthy_xml, faulty_xml = healthy.to_xml(), faulty.to_xml()
-  changed = [line for line, other in zip(healthy_xml.splitlines(), faulty_xml.splitlines())
-             if line != other]
+  changed = [
+    line for line, other in zip(healthy_xml.splitlines(), faulty_xml.splitlines()) if line != other
+  ]
   assert len(changed) == len(faulty.faults)
   strip = lambda xml: re.sub(r' gainprm="[^"]*"', "", xml)
   assert strip(healthy_xml) == strip(faulty_xml)
@@ -97,8 +102,9 @@ def test_the_faulty_mjcf_differs_only_in_the_faulty_gains(name):
 @pytest.mark.parametrize("name", robots.BENCHMARK_ROBOTS)
 def test_gain_one_gives_an_identical_model(name):
   healthy = robots.make(name)
-  whole = healthy.with_faults(faults.Fault(f.module, f.actuator, 1.0)
-                              for f in _test_faults(healthy))
+  whole = healthy.with_faults(
+    faults.Fault(f.module, f.actuator, 1.0) for f in _test_faults(healthy)
+  )
   assert whole.to_xml() == healthy.to_xml()
   assert whole.without_faults() == healthy
 
@@ -118,16 +124,23 @@ def test_a_punctured_cable_stops_pulling_in_physics():
   np.testing.assert_allclose(tips["cut"], rest_tip, atol=1e-6)
 
 
-@pytest.mark.parametrize("text,expected", [("2:0:0.3", faults.Fault(2, 0, 0.3)),
-                                           (" 1:3:0 ", faults.Fault(1, 3, 0.0)),
-                                           ("3:2:1", faults.Fault(3, 2, 1.0))])
+@pytest.mark.parametrize(
+  "text,expected",
+  [
+    ("2:0:0.3", faults.Fault(2, 0, 0.3)),
+    (" 1:3:0 ", faults.Fault(1, 3, 0.0)),
+    ("3:2:1", faults.Fault(3, 2, 1.0)),
+  ],
+)
 def test_parse(text, expected):
   parsed = faults.parse(text)
   assert parsed == expected and faults.parse(str(parsed)) == parsed
   assert parsed.punctured == (expected.gain == 0)
 
 
-@pytest.mark.parametrize("robot,text,message", [
+@pytest.mark.parametrize(
+  "robot,text,message",
+  [
     ("tendon-3", "2:0", "malformed fault"),
     ("tendon-3", "2:0:0.3:1", "malformed fault"),
     ("tendon-3", "two:0:0.3", "module must be an integer"),
@@ -140,7 +153,8 @@ def test_parse(text, expected):
     ("tendon-3", "4:0:0.5", "tendon-3 has modules 1 to 3, not 4"),
     ("tendon-3", "2:4:0.5", "module 2 of tendon-3 has actuators 0 to 3, not 4"),
     ("pneumatic-433", "2:3:0.5", "module 2 of pneumatic-433 has actuators 0 to 2, not 3"),
-])
+  ],
+)
 def test_bad_faults_are_one_line_errors(robot, text, message):
   with pytest.raises(ValueError, match=message) as error:
     robots.make(robot).with_faults([faults.parse(text)])
@@ -161,7 +175,9 @@ def test_targets_are_the_healthy_robots():
     np.testing.assert_array_equal(first, second)
 
 
-@pytest.mark.parametrize("arguments", [
+@pytest.mark.parametrize(
+  "arguments",
+  [
     ["run", "--task", "spiral", "--agent", "zero", "--robot", "tendon-2", "--fault", "2:9:0.5"],
     ["run", "--task", "spiral", "--agent", "zero", "--robot", "tendon-2", "--fault", "2-0-0.5"],
     ["retrain", "--robot", "tendon-2", "--fault", "2:0:7"],
@@ -169,7 +185,8 @@ def test_targets_are_the_healthy_robots():
     ["retrain", "--robot", "tendon-2"],
     ["retrain", "--robot", "tendon-2", "--fault", "2:0:0", "--agent", "lstm"],
     ["retrain", "--robot", "tendon-2", "--fault", "2:0:0", "--baseline", "random"],
-])
+  ],
+)
 def test_cli_bad_faults_exit_2_with_one_line(arguments, capsys):
   assert cli.main(arguments + ["--profile", "tiny"]) == cli.EXIT_USAGE
   error = capsys.readouterr().err
@@ -180,16 +197,39 @@ def test_cli_run_evaluates_under_the_fault(tmp_path, capsys):
   records = {}
   for label, fault in (("healthy", []), ("cut", ["--fault", "2:0:0", "--fault", "2:2:0"])):
     json_path = tmp_path / f"{label}.json"
-    assert cli.main(["run", "--task", "circle", "--agent", "random", "--robot", "tendon-2",
-                     "--profile", "tiny", "--seeds", "1", "--results", str(tmp_path / "results"),
-                     "--json", str(json_path), *fault]) == 0
+    assert (
+      cli.main(
+        [
+          "run",
+          "--task",
+          "circle",
+          "--agent",
+          "random",
+          "--robot",
+          "tendon-2",
+          "--profile",
+          "tiny",
+          "--seeds",
+          "1",
+          "--results",
+          str(tmp_path / "results"),
+          "--json",
+          str(json_path),
+          *fault,
+        ]
+      )
+      == 0
+    )
     records[label] = json.loads(json_path.read_text())
   assert "under fault 2:0:0, 2:2:0" in capsys.readouterr().out
   assert records["healthy"]["faults"] == []
-  assert [f["actuator_name"] for f in records["cut"]["faults"]] == ["module2_cable_xpos",
-                                                                   "module2_cable_xneg"]
-  errors = {label: record["per_seed"][0]["position_mm"]["per_module"]
-            for label, record in records.items()}
+  assert [f["actuator_name"] for f in records["cut"]["faults"]] == [
+    "module2_cable_xpos",
+    "module2_cable_xneg",
+  ]
+  errors = {
+    label: record["per_seed"][0]["position_mm"]["per_module"] for label, record in records.items()
+  }
   assert errors["healthy"][1] != errors["cut"][1]
   fault_records = (tmp_path / "results").glob("*fault*.json")
   assert sorted(path.name.split("-fault")[1][:5] for path in fault_records) == ["2.0.0"]
@@ -228,22 +268,49 @@ def test_the_kept_forward_models_are_bit_identical():
   healthy = robots.make("tendon-2")
   smpl = agents.make("smpl", healthy, 0, "tiny")
   retrained = adaptation.retrain_column(
-      smpl, healthy.with_faults([faults.parse("2:0:0.3")]), profiles.get("tiny"))
+    smpl, healthy.with_faults([faults.parse("2:0:0.3")]), profiles.get("tiny")
+  )
   kept, changed = (controller.forward.state_dict() for controller in retrained.agent.controllers)
-  assert all(torch.equal(tensor, kept[name])
-             for name, tensor in smpl.controllers[0].forward.state_dict().items())
-  assert not all(torch.equal(tensor, changed[name])
-                 for name, tensor in smpl.controllers[1].forward.state_dict().items())
+  assert all(
+    torch.equal(tensor, kept[name])
+    for name, tensor in smpl.controllers[0].forward.state_dict().items()
+  )
+  assert not all(
+    torch.equal(tensor, changed[name])
+    for name, tensor in smpl.controllers[1].forward.state_dict().items()
+  )
 
 
 def test_cli_retrain_end_to_end(tmp_path, capsys):
   json_path = tmp_path / "record.json"
-  assert cli.main(["retrain", "--robot", "tendon-2", "--fault", "2:0:0.3", "--profile", "tiny",
-                   "--seeds", "1", "--results", str(tmp_path / "results"),
-                   "--json", str(json_path)]) == 0
+  assert (
+    cli.main(
+      [
+        "retrain",
+        "--robot",
+        "tendon-2",
+        "--fault",
+        "2:0:0.3",
+        "--profile",
+        "tiny",
+        "--seeds",
+        "1",
+        "--results",
+        str(tmp_path / "results"),
+        "--json",
+        str(json_path),
+      ]
+    )
+    == 0
+  )
   out = capsys.readouterr().out
-  for row in ("before the fault", "under the fault", "column 2 retrained",
-              "lstm, retrained from scratch", "bit-identical after retraining: yes"):
+  for row in (
+    "before the fault",
+    "under the fault",
+    "column 2 retrained",
+    "lstm, retrained from scratch",
+    "bit-identical after retraining: yes",
+  ):
     assert row in out
   record = json.loads(json_path.read_text())
   fault = record["fault"]
@@ -262,15 +329,18 @@ def test_a_damaged_retrained_column_is_trained_again(assert_one_line_retraining)
   smpl = agents.make("smpl", healthy, 0, "tiny")
   first = adaptation.retrain_column(smpl, faulty, profiles.get("tiny"))  # Trained or cached.
   (path,) = (storage.softbench_home() / learned.CHECKPOINT_FOLDER).glob(
-      "smpl-tendon-2-fault1.0.0.5-*.pt")
+    "smpl-tendon-2-fault1.0.0.5-*.pt"
+  )
   path.write_bytes(b"hello")
   with pytest.warns(data.CorruptFileWarning) as caught:
     again = adaptation.retrain_column(smpl, faulty, profiles.get("tiny"))
   assert_one_line_retraining(caught, path)
   assert again.trained_now and again.wall_time_s == adaptation.read_wall_time(path)
   assert _state(first.agent.inverse).keys() == again.agent.inverse.state_dict().keys()
-  assert all(torch.equal(tensor, again.agent.inverse.state_dict()[name])
-             for name, tensor in _state(first.agent.inverse).items())  # Deterministic retraining.
+  assert all(
+    torch.equal(tensor, again.agent.inverse.state_dict()[name])
+    for name, tensor in _state(first.agent.inverse).items()
+  )  # Deterministic retraining.
   assert not adaptation.retrain_column(smpl, faulty, profiles.get("tiny")).trained_now
 
 
@@ -280,8 +350,9 @@ def test_the_baselines_timing_notices_a_damaged_checkpoint_trained_again():
   retrain._timed_baseline(settings, faulty, 0, False)  # Trained, or found in the shared home.
   _, seconds, trained_now = retrain._timed_baseline(settings, faulty, 0, False)
   assert not trained_now
-  path = learned.checkpoint_path(settings.baseline, faulty, 0, settings.run.profile,
-                                 per_module=False)
+  path = learned.checkpoint_path(
+    settings.baseline, faulty, 0, settings.run.profile, per_module=False
+  )
   path.write_bytes(path.read_bytes()[:500])
   with pytest.warns(data.CorruptFileWarning):
     _, seconds, trained_now = retrain._timed_baseline(settings, faulty, 0, False)

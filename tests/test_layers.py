@@ -34,7 +34,7 @@ def _imported(path: pathlib.Path, module: str) -> set[str]:
     elif isinstance(node, ast.ImportFrom):
       base = node.module or ""
       if node.level:
-        anchor = package.split(".")[:len(package.split(".")) - node.level + 1]
+        anchor = package.split(".")[: len(package.split(".")) - node.level + 1]
         base = ".".join(anchor + ([node.module] if node.module else []))
       names.add(base)
       names.update(f"{base}.{alias.name}" for alias in node.names)
@@ -67,7 +67,7 @@ def find_cycle(graph: dict[str, dict[str, list[str]]]) -> list[str] | None:
     stack.append(unit)
     for other in sorted(graph.get(unit, {})):
       if state.get(other) == "open":
-        return stack[stack.index(other):] + [other]
+        return stack[stack.index(other) :] + [other]
       if other not in state and (cycle := visit(other)):
         return cycle
     state[unit] = "done"
@@ -84,9 +84,10 @@ def test_softbench_units_import_without_a_cycle():
   graph = import_graph()
   assert {"robots", "suite", "run", "leaderboard", "records"} <= set(graph)
   cycle = find_cycle(graph)
-  assert cycle is None, " -> ".join(
-      f"{unit} ({graph[unit][other][0]})" for unit, other in zip(cycle, cycle[1:])) + \
-      f" -> {cycle[-1]}"
+  assert cycle is None, (
+    " -> ".join(f"{unit} ({graph[unit][other][0]})" for unit, other in zip(cycle, cycle[1:]))
+    + f" -> {cycle[-1]}"
+  )
 
 
 def test_the_cycle_finder_finds_a_cycle():
@@ -97,13 +98,15 @@ def test_the_cycle_finder_finds_a_cycle():
 
 
 # The physics side and the environments: tests/test_envs.py.
-@pytest.mark.parametrize("modules", [
+@pytest.mark.parametrize(
+  "modules",
+  [
     "softbench.agents, softbench.agents.hyperparameters",
     "softbench.records, softbench.records.exp1s, softbench.records.provenance",
     "softbench.leaderboard, softbench.leaderboard.html_page, softbench.leaderboard.overview",
-])
+  ],
+)
 def test_the_registries_and_the_records_import_without_torch(modules):
   code = f"import sys, {modules}; print('torch' in sys.modules)"
-  result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                          check=True)
+  result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
   assert result.stdout.strip() == "False"

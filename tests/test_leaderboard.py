@@ -34,8 +34,9 @@ def real_record(tmp_path_factory) -> dict:
     return run.execute(settings, show_progress=False, workers=1)
 
 
-def variant(record: dict, agent: str | None = None, date: str | None = None, scale: float = 1.0,
-            **fields) -> dict:
+def variant(
+  record: dict, agent: str | None = None, date: str | None = None, scale: float = 1.0, **fields
+) -> dict:
   """A sealed copy of ``record`` with another agent or date, ``fields`` replaced (``None``
   removes one), then errors times ``scale``."""
   changed = copy.deepcopy(record)
@@ -102,37 +103,56 @@ def _set(path, value):
       del target[last]
     else:
       target[last] = value
+
   return change
 
 
 MALFORMED = {
-    "hand-edited number": (_tamper, False, "does not match its sha256"),
-    "no hash": (_set(["sha256"], None), False, "'sha256' is a required property"),
-    "missing field": (_set(["robot"], None), True, "'robot' is a required property"),
-    "negative error": (_set(["per_seed", 0, "position_mm", "mean"], -1.0), True,
-                       r"per_seed\[0\].position_mm.mean: -1.0 is less than the minimum of 0"),
-    "NaN": (_set(["per_seed", 1, "mean_reward"], math.nan), False, "not a finite number"),
-    "unknown task": (_set(["task"], "juggle"), True, "'juggle' is not one of"),
-    "extra scalar field": (_set(["score"], 3), True, "score: unknown field"),
-    "old version": (_set(["version"], 1), True, "record version 1 is not read"),
-    "other format": (_set(["format"], "csv"), True, "not a result record"),
-    "format not a string": (_set(["format"], []), True, r"not a result record \(format \[\]"),
-    "astronomical error": (_set(["per_seed", 0, "position_mm", "per_module"], [1e308]), True,
-                           r"per_module\[0\]: 1e\+308 is greater than the maximum of 1000000"),
-    "integer beyond floats": (_set(["per_seed", 0, "position_mm", "per_module"], [10**400]),
-                              True, "is greater than the maximum of 1000000"),
-    "astronomical wall time": (_set(["wall_time_s"], 1e300), True,
-                               r"wall_time_s: 1e\+300 is greater than the maximum"),
-    "seed count": (_set(["seeds"], 3), True, "seeds is 3 but per_seed has 2 entries"),
-    "repeated seed": (_set(["per_seed", 1, "seed"], 0), True, "repeats a seed"),
-    "module count": (_set(["per_seed", 0, "position_mm", "per_module"], [1.0, 1.0]), True,
-                     "has 2 values for 1 scored modules"),
-    "mean over modules": (_set(["per_seed", 0, "normalised_tip_percent", "mean"], 123.0), True,
-                          "is not the mean of its per_module values"),
-    "module beyond the robot": (_set(["scored_modules"], [2]), True, "beyond tendon-1's 1"),
-    "robot": (_set(["robot"], "tendon-0"), True, "robot: "),
-    "trajectory": (_set(["trajectory"], "path.csv"), True, "trajectory goes with task custom"),
-    "date": (_set(["date"], "yesterday"), True, "not an ISO 8601 date"),
+  "hand-edited number": (_tamper, False, "does not match its sha256"),
+  "no hash": (_set(["sha256"], None), False, "'sha256' is a required property"),
+  "missing field": (_set(["robot"], None), True, "'robot' is a required property"),
+  "negative error": (
+    _set(["per_seed", 0, "position_mm", "mean"], -1.0),
+    True,
+    r"per_seed\[0\].position_mm.mean: -1.0 is less than the minimum of 0",
+  ),
+  "NaN": (_set(["per_seed", 1, "mean_reward"], math.nan), False, "not a finite number"),
+  "unknown task": (_set(["task"], "juggle"), True, "'juggle' is not one of"),
+  "extra scalar field": (_set(["score"], 3), True, "score: unknown field"),
+  "old version": (_set(["version"], 1), True, "record version 1 is not read"),
+  "other format": (_set(["format"], "csv"), True, "not a result record"),
+  "format not a string": (_set(["format"], []), True, r"not a result record \(format \[\]"),
+  "astronomical error": (
+    _set(["per_seed", 0, "position_mm", "per_module"], [1e308]),
+    True,
+    r"per_module\[0\]: 1e\+308 is greater than the maximum of 1000000",
+  ),
+  "integer beyond floats": (
+    _set(["per_seed", 0, "position_mm", "per_module"], [10**400]),
+    True,
+    "is greater than the maximum of 1000000",
+  ),
+  "astronomical wall time": (
+    _set(["wall_time_s"], 1e300),
+    True,
+    r"wall_time_s: 1e\+300 is greater than the maximum",
+  ),
+  "seed count": (_set(["seeds"], 3), True, "seeds is 3 but per_seed has 2 entries"),
+  "repeated seed": (_set(["per_seed", 1, "seed"], 0), True, "repeats a seed"),
+  "module count": (
+    _set(["per_seed", 0, "position_mm", "per_module"], [1.0, 1.0]),
+    True,
+    "has 2 values for 1 scored modules",
+  ),
+  "mean over modules": (
+    _set(["per_seed", 0, "normalised_tip_percent", "mean"], 123.0),
+    True,
+    "is not the mean of its per_module values",
+  ),
+  "module beyond the robot": (_set(["scored_modules"], [2]), True, "beyond tendon-1's 1"),
+  "robot": (_set(["robot"], "tendon-0"), True, "robot: "),
+  "trajectory": (_set(["trajectory"], "path.csv"), True, "trajectory goes with task custom"),
+  "date": (_set(["date"], "yesterday"), True, "not an ISO 8601 date"),
 }
 
 
@@ -152,7 +172,7 @@ def test_the_cli_refuses_a_folder_with_a_bad_record(real_record, tmp_path, capsy
   bad = records.seal(real_record)
   _tamper(bad)
   write_raw(bad, tmp_path / "edited.json", reseal=False)
-  (tmp_path / "broken.json").write_text("{\"format\": ")
+  (tmp_path / "broken.json").write_text('{"format": ')
   assert cli.main(["leaderboard", "--results", str(tmp_path)]) == cli.EXIT_USAGE
   lines = capsys.readouterr().err.strip().splitlines()
   assert len(lines) == 1 and "broken.json: not valid JSON" in lines[0]  # Files in name order.
@@ -162,8 +182,8 @@ def test_the_cli_refuses_a_folder_with_a_bad_record(real_record, tmp_path, capsy
 
 
 UNPARSABLE = {
-    "nested too deeply": ("[" * 100_000 + "]" * 100_000, "nested too deeply"),
-    "too many digits": ('{"format": ' + "1" * 5000 + "}", "integer string conversion"),
+  "nested too deeply": ("[" * 100_000 + "]" * 100_000, "nested too deeply"),
+  "too many digits": ('{"format": ' + "1" * 5000 + "}", "integer string conversion"),
 }
 
 
@@ -189,8 +209,9 @@ def test_a_broken_link_is_refused_as_one(real_record, tmp_path, capsys):
     records.read(tmp_path / "missing.json")
 
 
-def test_an_unreadable_results_folder_is_an_error_not_an_empty_one(real_record, tmp_path,
-                                                                     monkeypatch, capsys):
+def test_an_unreadable_results_folder_is_an_error_not_an_empty_one(
+  real_record, tmp_path, monkeypatch, capsys
+):
   records.write(real_record, tmp_path / "good.json")
   scandir = os.scandir
 
@@ -202,8 +223,10 @@ def test_an_unreadable_results_folder_is_an_error_not_an_empty_one(real_record, 
   monkeypatch.setattr(os, "scandir", forbidden)
   assert cli.main(["leaderboard", "--results", str(tmp_path)]) == cli.EXIT_USAGE
   captured = capsys.readouterr()
-  assert captured.err == (f"softbench: error: {tmp_path}: the folder of result records cannot "
-                          f"be read (Permission denied)\n")
+  assert captured.err == (
+    f"softbench: error: {tmp_path}: the folder of result records cannot "
+    f"be read (Permission denied)\n"
+  )
   assert "no result records" not in captured.out
 
 
@@ -218,10 +241,14 @@ def test_run_refuses_to_write_a_malformed_record(real_record, tmp_path):
 def test_bootstrap_interval():
   values = [3.0, 1.0, 4.0, 1.5, 5.0]
   estimate = ranking.Estimate.of(values)
-  expected = stats.bootstrap((np.array(values),), np.mean, n_resamples=10_000,
-                             method="percentile", rng=np.random.default_rng(0))
-  assert estimate.interval == (expected.confidence_interval.low,
-                               expected.confidence_interval.high)
+  expected = stats.bootstrap(
+    (np.array(values),),
+    np.mean,
+    n_resamples=10_000,
+    method="percentile",
+    rng=np.random.default_rng(0),
+  )
+  assert estimate.interval == (expected.confidence_interval.low, expected.confidence_interval.high)
   assert min(values) <= estimate.interval[0] < estimate.mean < estimate.interval[1] <= max(values)
   assert (estimate.mean, estimate.std) == (np.mean(values), np.std(values))
   assert ranking.Estimate.of([2.0]).interval is None
@@ -236,15 +263,17 @@ def results(real_record, tmp_path) -> pathlib.Path:
   record with a fault section, and videos (a path and a URL)."""
   folder = tmp_path / "results"
   made = {
-      "zero-old.json": variant(real_record, date="2020-01-01T00:00:00+00:00", scale=0.1),
-      "zero.json": variant(real_record, video="videos/zero.mp4"),
-      "good.json": variant(real_record, agent="good", scale=0.5,
-                           video="https://example.org/good.mp4"),
-      "bad.json": variant(real_record, agent="bad", scale=2.0),
-      "single.json": variant(real_record, agent="single", scale=0.8, seeds=1,
-                             per_seed=real_record["per_seed"][:1]),
-      "reach.json": records.seal(position_only(real_record)),
-      "fault.json": variant(real_record, fault={"module": 1, "kind": "dead"}),
+    "zero-old.json": variant(real_record, date="2020-01-01T00:00:00+00:00", scale=0.1),
+    "zero.json": variant(real_record, video="videos/zero.mp4"),
+    "good.json": variant(
+      real_record, agent="good", scale=0.5, video="https://example.org/good.mp4"
+    ),
+    "bad.json": variant(real_record, agent="bad", scale=2.0),
+    "single.json": variant(
+      real_record, agent="single", scale=0.8, seeds=1, per_seed=real_record["per_seed"][:1]
+    ),
+    "reach.json": records.seal(position_only(real_record)),
+    "fault.json": variant(real_record, fault={"module": 1, "kind": "dead"}),
   }
   for name, record in made.items():
     records.write(record, folder / name)
@@ -264,19 +293,23 @@ def test_ranking(results):
   assert board.groups[2].metrics == ("position_mm", "normalised_tip_percent")
 
 
-def test_an_agent_that_learns_by_acting_shows_its_steps_and_ranks_with_the_others(real_record,
-                                                                                  tmp_path):
+def test_an_agent_that_learns_by_acting_shows_its_steps_and_ranks_with_the_others(
+  real_record, tmp_path
+):
   folder = tmp_path / "results"
-  spent = {"per_seed": [{"seed": 0, "environment_steps": 30000, "episodes": 601,
-                         "wall_time_s": 1500.0},
-                        {"seed": 1, "environment_steps": 30000, "episodes": 601,
-                         "wall_time_s": 2100.0}]}
-  records.write(variant(real_record, agent="sac", scale=0.5, training=spent),
-                   folder / "sac.json")
+  spent = {
+    "per_seed": [
+      {"seed": 0, "environment_steps": 30000, "episodes": 601, "wall_time_s": 1500.0},
+      {"seed": 1, "environment_steps": 30000, "episodes": 601, "wall_time_s": 2100.0},
+    ]
+  }
+  records.write(variant(real_record, agent="sac", scale=0.5, training=spent), folder / "sac.json")
   records.write(variant(real_record, zoo={"files": ["checkpoints/x.pt"]}), folder / "zero.json")
   (circle,) = leaderboard.build(folder).groups  # Neither section makes a group of its own.
   assert [entry.shown_setting for entry in circle.entries] == [
-      ("sac (30,000 steps, 30 min per seed)", "tiny", "physics"), ("zero", "tiny", "physics")]
+    ("sac (30,000 steps, 30 min per seed)", "tiny", "physics"),
+    ("zero", "tiny", "physics"),
+  ]
   with pytest.raises(records.RecordError, match="environment_steps"):
     variant(real_record, agent="sac", training={"per_seed": [{"seed": 0, "environment_steps": 0}]})
 
@@ -338,10 +371,11 @@ def test_pages_contain_every_record(results, tmp_path, capsys):
   assert "(<../results/videos/zero.mp4>)" in markdown
   assert 'href="../results/videos/zero.mp4"' in page
   assert 'href="https://example.org/good.mp4"' in page
-  assert page.count("<table class=\"sortable\">") == 3 and page.count("<svg") == 3 + 3 + 2
+  assert page.count('<table class="sortable">') == 3 and page.count("<svg") == 3 + 3 + 2
   assert "<link" not in page and "src=" not in page  # Self-contained: nothing to fetch.
-  good = ranking.Estimate.of([seed["position_mm"]["mean"] for seed in
-                              records.read(results / "good.json")["per_seed"]])
+  good = ranking.Estimate.of(
+    [seed["position_mm"]["mean"] for seed in records.read(results / "good.json")["per_seed"]]
+  )
   assert ranking.cell(good) in markdown and ranking.cell(good) in page
 
 

@@ -46,8 +46,14 @@ def checkout(tmp_path) -> pathlib.Path:
 
 
 def _fill(checkout: pathlib.Path) -> list[str]:
-  subprocess.run(["make", "--no-print-directory", "leaderboard", "PROFILE=paper"], cwd=checkout,
-                 check=True, capture_output=True, text=True, timeout=60)
+  subprocess.run(
+    ["make", "--no-print-directory", "leaderboard", "PROFILE=paper"],
+    cwd=checkout,
+    check=True,
+    capture_output=True,
+    text=True,
+    timeout=60,
+  )
   return (checkout / ".venv" / "bin" / "calls.txt").read_text().splitlines()
 
 
@@ -55,13 +61,17 @@ def test_the_fill_runs_every_agent_on_every_task_then_exp1s_then_the_pages(check
   calls = _fill(checkout)
   assert set(_variable("LEADERBOARD_AGENTS")) == set(agents.AGENTS)
   runs = [call for call in calls if "--task" in call]
-  assert len(runs) == (len(_variable("LEADERBOARD_ROBOTS")) * len(_variable("LEADERBOARD_TASKS"))
-                       * len(agents.AGENTS))
+  assert len(runs) == (
+    len(_variable("LEADERBOARD_ROBOTS")) * len(_variable("LEADERBOARD_TASKS")) * len(agents.AGENTS)
+  )
   assert all("--profile paper" in call for call in runs)
   exp1s = [call for call in calls if "--protocol exp1s" in call]
-  assert exp1s == [f"run --protocol exp1s --family {family} --agent smpl --profile paper "
-                   f"--results leaderboard/results" for family in robots.TENDON_FAMILIES]
-  assert calls[-len(exp1s) - 1:-1] == exp1s  # After every task's runs.
+  assert exp1s == [
+    f"run --protocol exp1s --family {family} --agent smpl --profile paper "
+    f"--results leaderboard/results"
+    for family in robots.TENDON_FAMILIES
+  ]
+  assert calls[-len(exp1s) - 1 : -1] == exp1s  # After every task's runs.
   assert calls[-1] == "leaderboard --results leaderboard/results --write"
 
 
@@ -77,8 +87,9 @@ def test_an_interrupted_fill_skips_the_settings_that_have_records(checkout):
   assert sum("--robot tendon-local-3 --task spiral --agent smpl " in call for call in calls) == 1
   # The tendon family's Exp1S record does not stand for the tendon-local family's.
   assert [call for call in calls if "exp1s" in call] == [
-      "run --protocol exp1s --family tendon-local --agent smpl --profile paper "
-      "--results leaderboard/results"]
+    "run --protocol exp1s --family tendon-local --agent smpl --profile paper "
+    "--results leaderboard/results"
+  ]
   assert calls[-1].startswith("leaderboard")
   (results / "smpl-exp1s-tendon-local-paper-2026-11-24T000000Z.json").touch()
   (checkout / ".venv" / "bin" / "calls.txt").unlink()

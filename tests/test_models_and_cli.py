@@ -43,8 +43,11 @@ def test_cli_export_writes_every_benchmark_model(tmp_path, monkeypatch):
   monkeypatch.setattr(export, "readme", lambda robot, speed: f"# {robot.name}\n")
   assert cli.main(["models", "export", "--out", str(tmp_path)]) == 0
   written = sorted(str(p.relative_to(tmp_path)) for p in tmp_path.rglob("*") if p.is_file())
-  assert written == sorted(f"{name}/{file}" for name in robots.BENCHMARK_ROBOTS
-                           for file in (f"{name}.xml", "scene.xml", "README.md"))
+  assert written == sorted(
+    f"{name}/{file}"
+    for name in robots.BENCHMARK_ROBOTS
+    for file in (f"{name}.xml", "scene.xml", "README.md")
+  )
 
 
 @pytest.mark.parametrize("name", robots.BENCHMARK_ROBOTS)
@@ -54,9 +57,14 @@ def test_exported_scene_compiles(name):
   assert model.geom("floor").id >= 0
 
 
-@pytest.mark.parametrize("name", [name for name in robots.BENCHMARK_ROBOTS
-                                  if name.startswith("tendon-local-")
-                                  and robots.make(name).num_modules >= 3])
+@pytest.mark.parametrize(
+  "name",
+  [
+    name
+    for name in robots.BENCHMARK_ROBOTS
+    if name.startswith("tendon-local-") and robots.make(name).num_modules >= 3
+  ],
+)
 def test_exported_local_arm_bends_only_the_pulled_module(name):
   # Gravity off, one cable of module 3 pulled at Tmax for 3 s, on the exported scene as a user
   # loads it: module 1's tip turns 0.0 deg, module 3's 91.2 deg (tendon-3: 30.6 and 152.4 deg).
@@ -100,8 +108,9 @@ def test_cli_lists_robots_tasks_and_agents_as_json(capsys):
   assert [agent["name"] for agent in listed_agents] == list(agents.AGENTS)
   for agent in listed_agents:
     assert agent["learned"] == agents.describe(agent["name"]).learned
-    assert bool(agent["hyperparameters"]) == (agent["learned"] and agent["name"] in
-                                              hyperparameters.load()["agents"])
+    assert bool(agent["hyperparameters"]) == (
+      agent["learned"] and agent["name"] in hyperparameters.load()["agents"]
+    )
 
 
 def test_cli_describes_any_valid_tendon_arm(capsys):
@@ -109,11 +118,19 @@ def test_cli_describes_any_valid_tendon_arm(capsys):
   assert capsys.readouterr().out.splitlines()[1].split()[:3] == ["tendon-7", "7", "14"]
 
 
-@pytest.mark.parametrize("argv", [
-    ["robots", "tendon-0"], ["robots", "tendon-x"], ["robots", "tendon-1000"],
-    ["robots", "tendon-local-0"], ["robots", "tendon-local-x"], ["robots", "tendon-local-"],
-    ["robots", "unicorn"], ["robots", "tendon-3", "--module-length", "-0.05"],
-])
+@pytest.mark.parametrize(
+  "argv",
+  [
+    ["robots", "tendon-0"],
+    ["robots", "tendon-x"],
+    ["robots", "tendon-1000"],
+    ["robots", "tendon-local-0"],
+    ["robots", "tendon-local-x"],
+    ["robots", "tendon-local-"],
+    ["robots", "unicorn"],
+    ["robots", "tendon-3", "--module-length", "-0.05"],
+  ],
+)
 def test_cli_refuses_bad_input_with_one_line_and_exit_code_2(argv, capsys):
   assert cli.main(argv) == cli.EXIT_USAGE
   captured = capsys.readouterr()
@@ -125,10 +142,19 @@ def test_cli_refuses_bad_input_with_one_line_and_exit_code_2(argv, capsys):
 
 
 def test_cli_export_refuses_a_bad_robot_before_writing(tmp_path, capsys):
-  argv = ["models", "export", "--out", str(tmp_path), "--robots", "tendon-local-1", "tendon-local-0"]
+  argv = [
+    "models",
+    "export",
+    "--out",
+    str(tmp_path),
+    "--robots",
+    "tendon-local-1",
+    "tendon-local-0",
+  ]
   assert cli.main(argv) == cli.EXIT_USAGE
   assert capsys.readouterr().err.strip() == (
-      "softbench: error: tendon-local arms have 1 to 10 modules, got 0")
+    "softbench: error: tendon-local arms have 1 to 10 modules, got 0"
+  )
   assert not any(tmp_path.iterdir())
 
 
@@ -163,13 +189,17 @@ def test_cli_collects_a_dataset_then_finds_it(tmp_path, monkeypatch, capsys):
   assert (folder / "dataset.npz").read_bytes() == before
 
 
-@pytest.mark.parametrize("argv", [
-    ["collect", "--robot", "tendon-0"], ["collect", "--robot", "unicorn"],
+@pytest.mark.parametrize(
+  "argv",
+  [
+    ["collect", "--robot", "tendon-0"],
+    ["collect", "--robot", "unicorn"],
     ["collect", "--robot", "tendon-2", "--samples", "0"],
     ["collect", "--robot", "tendon-2", "--seed", "-1"],
     ["collect", "--robot", "tendon-2", "--workers", "0"],
     ["collect", "--robot", "tendon-2", "--samples", "100000000000000"],  # Would fill the memory.
-])
+  ],
+)
 def test_cli_collect_refuses_bad_input(argv, capsys, tmp_path, monkeypatch):
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
   assert cli.main(argv) == cli.EXIT_USAGE
@@ -181,20 +211,29 @@ def test_cli_collect_refuses_bad_input(argv, capsys, tmp_path, monkeypatch):
 @pytest.mark.parametrize("backend", ["bogus"])
 def test_an_opengl_backend_mujoco_cannot_load_is_one_line(backend):
   environment = {**os.environ, "MUJOCO_GL": backend}
-  result = subprocess.run([sys.executable, "-m", "softbench.launcher", "robots"], env=environment,
-                          capture_output=True, text=True, timeout=120)
+  result = subprocess.run(
+    [sys.executable, "-m", "softbench.launcher", "robots"],
+    env=environment,
+    capture_output=True,
+    text=True,
+    timeout=120,
+  )
   assert result.returncode == cli.EXIT_USAGE
   assert result.stderr.count("\n") == 1 and f"MUJOCO_GL='{backend}'" in result.stderr
 
 
 def test_an_egl_that_cannot_open_falls_back_to_osmesa_or_says_what_to_install(
-    broken_egl_environment, launch_with_broken_egl):
+  broken_egl_environment, launch_with_broken_egl
+):
   installed = softbench.installed_headless_backends()
   if "egl" not in installed:
     pytest.skip("EGL's library is not installed here, so softbench does not choose it")
-  probe = subprocess.run([sys.executable, "-c", "from dm_control import _render"],
-                         env={**os.environ, **broken_egl_environment, "MUJOCO_GL": "egl"},
-                         capture_output=True, timeout=120)
+  probe = subprocess.run(
+    [sys.executable, "-c", "from dm_control import _render"],
+    env={**os.environ, **broken_egl_environment, "MUJOCO_GL": "egl"},
+    capture_output=True,
+    timeout=120,
+  )
   if probe.returncode == 0:
     pytest.skip("EGL opens here even without its vendor files")
   result = launch_with_broken_egl(["robots"])
@@ -220,12 +259,17 @@ def _read_only_file_system(*args, **kwargs):
 
 
 @pytest.mark.parametrize("home", ["/dev/null", "under-a-file", "/proc/softbench", "read-only"])
-@pytest.mark.parametrize("command", [
+@pytest.mark.parametrize(
+  "command",
+  [
     ["run", "--task", "circle", "--agent", "zero", "--robot", "tendon-1", "--profile", "tiny"],
     ["collect", "--robot", "tendon-1", "--samples", "10"],
-    ["render", "--task", "circle", "--agent", "zero", "--robot", "tendon-1", "--out", "x.mp4"]])
-def test_a_data_home_that_takes_no_file_is_refused_before_any_work(home, command, tmp_path,
-                                                                   monkeypatch, capsys):
+    ["render", "--task", "circle", "--agent", "zero", "--robot", "tendon-1", "--out", "x.mp4"],
+  ],
+)
+def test_a_data_home_that_takes_no_file_is_refused_before_any_work(
+  home, command, tmp_path, monkeypatch, capsys
+):
   if home == "under-a-file":
     (tmp_path / "file").write_text("")
     home = str(tmp_path / "file" / "home")
@@ -242,9 +286,25 @@ def test_a_data_home_that_takes_no_file_is_refused_before_any_work(home, command
   assert error.startswith("softbench: error: cannot write the data home") and error.count("\n") == 1
 
 
-@pytest.mark.parametrize("argv", [["models", "export", "--out", "/etc/hostname"],
-                                  ["run", "--task", "circle", "--agent", "zero", "--robot",
-                                   "tendon-1", "--profile", "tiny", "--results", "/proc/results"]])
+@pytest.mark.parametrize(
+  "argv",
+  [
+    ["models", "export", "--out", "/etc/hostname"],
+    [
+      "run",
+      "--task",
+      "circle",
+      "--agent",
+      "zero",
+      "--robot",
+      "tendon-1",
+      "--profile",
+      "tiny",
+      "--results",
+      "/proc/results",
+    ],
+  ],
+)
 def test_outputs_that_take_no_file_are_refused_before_any_work(argv, monkeypatch, capsys):
   monkeypatch.setattr(run, "execute_episodes", _read_only_file_system)
   assert cli.main(argv) == cli.EXIT_USAGE

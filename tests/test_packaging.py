@@ -3,10 +3,10 @@ README's commands install with, the licence and citation files, and the version.
 
 import pathlib
 import re
-import tomllib
 
 from packaging import requirements
 from packaging import utils
+import tomllib
 
 import softbench
 from softbench import cli
@@ -27,15 +27,18 @@ def _pins() -> dict[str, str]:
 
 def _declared() -> list[requirements.Requirement]:
   project = PYPROJECT["project"]
-  return [requirements.Requirement(text) for text in
-          project["dependencies"] + sum(project["optional-dependencies"].values(), [])]
+  return [
+    requirements.Requirement(text)
+    for text in project["dependencies"] + sum(project["optional-dependencies"].values(), [])
+  ]
 
 
 def test_the_metadata_declares_ranges_not_exact_versions():
   for requirement in _declared():
     assert not any(spec.operator in ("==", "===") for spec in requirement.specifier), requirement
-    assert any(spec.operator == "<" for spec in requirement.specifier), \
-        f"{requirement} has no upper bound"
+    assert any(spec.operator == "<" for spec in requirement.specifier), (
+      f"{requirement} has no upper bound"
+    )
 
 
 def test_every_declared_dependency_is_pinned_within_its_range():

@@ -42,8 +42,9 @@ def test_every_seed_runs_one_torch_thread():
   before = torch.get_num_threads()
   torch.set_num_threads(2)
   try:  # In this process (one worker), for the seeds only.
-    assert parallel_seeds.over_seeds(lambda seed, show: torch_threads(seed), 2, (), "threads",
-                                     False, workers=1) == [1, 1]
+    assert parallel_seeds.over_seeds(
+      lambda seed, show: torch_threads(seed), 2, (), "threads", False, workers=1
+    ) == [1, 1]
     assert torch.get_num_threads() == 2
   finally:
     torch.set_num_threads(before)
@@ -69,8 +70,9 @@ except parallel_seeds.WorkerDied as error:
 def test_a_dead_worker_is_reported_not_waited_for():
   # In a child with a deadline: a hang fails the test (TimeoutExpired) instead of the suite.
   program = _DYING_PROGRAM.format(tests=os.path.dirname(__file__))
-  result = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True,
-                          timeout=CHILD_DEADLINE_S)
+  result = subprocess.run(
+    [sys.executable, "-c", program], capture_output=True, text=True, timeout=CHILD_DEADLINE_S
+  )
   assert "reported:" in result.stdout and "ended without a result" in result.stdout, result
 
 
@@ -126,6 +128,7 @@ print(parallel_seeds.in_processes(test_parallel_seeds.compiled_double, [(1.0,), 
 
 def compiled_double(value):
   import torch  # Only the workers pay for it.
+
   return float(torch.compile(lambda tensor: 2 * tensor)(torch.tensor(value)))
 
 
@@ -133,8 +136,9 @@ def test_finished_workers_exit_cleanly():
   # Terminating idle workers left torch.compile's pool semaphores to the resource tracker, which
   # warned "There appear to be 2 leaked semaphore objects" after every compiled training run.
   program = _COMPILING_PROGRAM.format(tests=os.path.dirname(__file__))
-  result = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True,
-                          timeout=300)
+  result = subprocess.run(
+    [sys.executable, "-c", program], capture_output=True, text=True, timeout=300
+  )
   assert result.returncode == 0, result.stderr
   assert result.stdout.strip().endswith("[2.0, 4.0]")
   assert "leaked" not in result.stderr, result.stderr

@@ -4,9 +4,9 @@
 import json
 
 import imageio_ffmpeg
+from matplotlib import image
 import numpy as np
 import pytest
-from matplotlib import image
 
 from softbench import agents
 from softbench import cli
@@ -55,18 +55,21 @@ def test_forgetting_matrix_is_a_heat_map_with_unseen_entries(tmp_path):
   configurations = [f"tendon-{k}" for k in range(1, 6)]
   matrix = np.full((5, 5), np.nan)
   for stage in range(5):
-    matrix[stage, :stage + 1] = np.linspace(1.0, 4.0, stage + 1)
+    matrix[stage, : stage + 1] = np.linspace(1.0, 4.0, stage + 1)
   path = plots.forgetting_matrix(matrix, configurations, tmp_path / "forgetting.png")
   assert png_size(path)[1] > png_size(path)[0] > 200
 
 
-@pytest.mark.parametrize("matrix,configurations,message", [
+@pytest.mark.parametrize(
+  "matrix,configurations,message",
+  [
     (np.ones(3), ["a", "b", "c"], "must be \\(stages, configurations\\)"),
     (np.ones((2, 3)), ["a", "b"], "3 columns but 2 configurations"),
     (np.full((2, 2), np.nan), ["a", "b"], "no evaluated entry"),
     (np.array([[1.0, -1.0]]), ["a", "b"], "non-negative"),
     (np.array([[1.0, np.inf]]), ["a", "b"], "finite"),
-])
+  ],
+)
 def test_forgetting_matrix_refuses_bad_input(matrix, configurations, message, tmp_path):
   with pytest.raises(ValueError, match=message):
     plots.forgetting_matrix(matrix, configurations, tmp_path / "bad.png")
@@ -76,9 +79,27 @@ def test_forgetting_matrix_refuses_bad_input(matrix, configurations, message, tm
 def test_softbench_run_saves_plots_and_a_video(tmp_path, capsys):
   results = tmp_path / "results"
   video = tmp_path / "run.mp4"
-  argv = ["run", "--task", "circle", "--agent", "zero", "--robot", "tendon-2", "--profile",
-          "tiny", "--seeds", "1", "--results", str(results), "--video", str(video), "--width", "64",
-          "--height", "48"]
+  argv = [
+    "run",
+    "--task",
+    "circle",
+    "--agent",
+    "zero",
+    "--robot",
+    "tendon-2",
+    "--profile",
+    "tiny",
+    "--seeds",
+    "1",
+    "--results",
+    str(results),
+    "--video",
+    str(video),
+    "--width",
+    "64",
+    "--height",
+    "48",
+  ]
   assert cli.main(argv) == 0
   out = capsys.readouterr().out
   (record_path,) = results.glob("*.json")

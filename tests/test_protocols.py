@@ -31,14 +31,22 @@ def test_the_paper_protocols_have_the_papers_columns():
     protocols.get("exp3")
 
 
-@pytest.mark.parametrize("protocol", [
+@pytest.mark.parametrize(
+  "protocol",
+  [
     protocols.Protocol("continual", ("tendon-1", "tendon-2"), False, "Exp1S in small"),
     protocols.Protocol("distributed", ("pneumatic-433",), True, "Exp2R: modules of 4, 3, 3"),
-])
+  ],
+)
 def test_protocol_trains_a_column_per_stage_and_never_forgets(protocol):
-  result = protocols.run(protocol, samples=SAMPLES, forward_config=TINY_FORWARD,
-                         inverse_config=TINY_INVERSE, device=torch.device("cpu"),
-                         progress=False)
+  result = protocols.run(
+    protocol,
+    samples=SAMPLES,
+    forward_config=TINY_FORWARD,
+    inverse_config=TINY_INVERSE,
+    device=torch.device("cpu"),
+    progress=False,
+  )
   stages = len(protocol.column_views())
   assert result.network.num_columns == stages
   assert all(column.forward_model.is_frozen for column in result.columns)
@@ -63,11 +71,21 @@ def test_protocol_reports_every_epoch_of_every_model_to_its_progress_bar():
     epochs[label] = []
     yield lambda report: epochs[label].append(report.epoch)
 
-  result = protocols.run(protocol, samples=SAMPLES, forward_config=TINY_FORWARD,
-                         inverse_config=TINY_INVERSE, device=torch.device("cpu"),
-                         progress=False, progress_bars=progress_bars)
-  assert list(epochs) == ["forward tendon-1 end-effector", "forward tendon-2 end-effector",
-                          "inverse tendon-1 end-effector", "inverse tendon-2 end-effector"]
+  result = protocols.run(
+    protocol,
+    samples=SAMPLES,
+    forward_config=TINY_FORWARD,
+    inverse_config=TINY_INVERSE,
+    device=torch.device("cpu"),
+    progress=False,
+    progress_bars=progress_bars,
+  )
+  assert list(epochs) == [
+    "forward tendon-1 end-effector",
+    "forward tendon-2 end-effector",
+    "inverse tendon-1 end-effector",
+    "inverse tendon-2 end-effector",
+  ]
   trained = [column.forward_training for column in result.columns] + result.run.training
   for label, training_result in zip(epochs, trained):
     assert epochs[label] == [report.epoch for report in training_result.history], label

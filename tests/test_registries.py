@@ -2,10 +2,10 @@
 task (``example_task.py``) each join by one registry line, and then build, train, run and score
 through the same code as the built-in ones. Registration is undone after each test."""
 
+import example_task
 import numpy as np
 import pytest
 
-import example_task
 from softbench import agents
 from softbench import evaluation
 from softbench import profiles
@@ -30,14 +30,23 @@ def restored_registries(monkeypatch):
 def _register_examples() -> None:
   # The one registry entry each addition takes (in the package: a line of agents._AGENTS or
   # suite._TASKS):
-  agents.register("linear", agents.AgentEntry(
-      None, True, "linear inverse model", agents.Learner(False, "example_agent:LinearInverse")))
-  suite.register("hold", suite.TaskEntry(
-      example_task.Hold, ("benchmarking",), "hold the starting pose", "tendon-3", "steps"))
+  agents.register(
+    "linear",
+    agents.AgentEntry(
+      None, True, "linear inverse model", agents.Learner(False, "example_agent:LinearInverse")
+    ),
+  )
+  suite.register(
+    "hold",
+    suite.TaskEntry(
+      example_task.Hold, ("benchmarking",), "hold the starting pose", "tendon-3", "steps"
+    ),
+  )
 
 
-def test_an_example_agent_and_task_join_by_one_line_each(restored_registries, tmp_path,
-                                                         monkeypatch):
+def test_an_example_agent_and_task_join_by_one_line_each(
+  restored_registries, tmp_path, monkeypatch
+):
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
   _register_examples()
   assert "linear" in agents.AGENTS and "linear" in agents.babbling_learners()
@@ -45,8 +54,9 @@ def test_an_example_agent_and_task_join_by_one_line_each(restored_registries, tm
   assert hyperparameters.values("linear", ROBOT) == {}  # No entry: the model's defaults.
   agent = agents.make("linear", ROBOT, seed=0, profile="tiny")
   assert isinstance(agent, learned.LearnedAgent)
-  path = learned.checkpoint_path("linear", robots.make(ROBOT), 0, profiles.get("tiny"),
-                                 per_module=False)
+  path = learned.checkpoint_path(
+    "linear", robots.make(ROBOT), 0, profiles.get("tiny"), per_module=False
+  )
   assert path.is_file() and path.name.startswith(f"linear-{ROBOT}-seed0-")
   env = suite.load(ROBOT, "hold", seed=1, **suite.length_options("hold", 5))
   episode = evaluation.run_episode(env, agent, "hold")
@@ -59,16 +69,25 @@ def test_registration_is_undone_between_tests():
   assert "linear" not in agents.AGENTS and "hold" not in suite.TASKS
 
 
-@pytest.mark.parametrize("register,message", [
-    (lambda: agents.register("zero", agents.AgentEntry("softbench.agents.zero", False, "again")),
-     "registered already"),
+@pytest.mark.parametrize(
+  "register,message",
+  [
+    (
+      lambda: agents.register("zero", agents.AgentEntry("softbench.agents.zero", False, "again")),
+      "registered already",
+    ),
     (lambda: agents.register("My Agent", agents.AgentEntry("x", False, "")), "lowercase"),
-    (lambda: agents.register("both", agents.AgentEntry(
-        "x", True, "", agents.Learner(True))), "either the module"),
+    (
+      lambda: agents.register("both", agents.AgentEntry("x", True, "", agents.Learner(True))),
+      "either the module",
+    ),
     (lambda: suite.register("spiral", suite.describe("spiral")), "registered already"),
-    (lambda: suite.register("new", suite.describe("spiral")._replace(paper_robot="octopus")),
-     "unknown robot"),
-])
+    (
+      lambda: suite.register("new", suite.describe("spiral")._replace(paper_robot="octopus")),
+      "unknown robot",
+    ),
+  ],
+)
 def test_a_bad_registration_is_refused_with_one_line(register, message, restored_registries):
   with pytest.raises(ValueError, match=message) as error:
     register()

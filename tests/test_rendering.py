@@ -2,7 +2,6 @@
 the replay check, frames that show a moving arm, MP4s that decode, the backend fallback, and
 ``softbench render`` / ``softbench run --video``."""
 
-
 import imageio_ffmpeg
 import mujoco
 import numpy as np
@@ -36,13 +35,20 @@ def recorded(robot="tendon-2", task="circle", agent="random", seed=0, **task_opt
   return replay.Replay(robots.make(robot), task, seed, task_options, episode, "test episode")
 
 
-@pytest.mark.parametrize("fields,message", [
-    ({"width": 641}, "even number"), ({"height": 0}, "even number"),
-    ({"width": 8192}, "even number"), ({"width": 64.0}, "even number"),
-    ({"fps": 0}, "fps must be"), ({"fps": float("nan")}, "fps must be"),
-    ({"fps": 1000}, "fps must be"), ({"camera": "nope"}, "unknown camera"),
+@pytest.mark.parametrize(
+  "fields,message",
+  [
+    ({"width": 641}, "even number"),
+    ({"height": 0}, "even number"),
+    ({"width": 8192}, "even number"),
+    ({"width": 64.0}, "even number"),
+    ({"fps": 0}, "fps must be"),
+    ({"fps": float("nan")}, "fps must be"),
+    ({"fps": 1000}, "fps must be"),
+    ({"camera": "nope"}, "unknown camera"),
     ({"frames_per_step": 0}, "frames per step"),
-])
+  ],
+)
 def test_bad_options_are_refused(fields, message):
   with pytest.raises(ValueError, match=message):
     options.VideoOptions(**fields)
@@ -51,8 +57,10 @@ def test_bad_options_are_refused(fields, message):
 def test_video_paths_are_checked(tmp_path):
   assert options.check_video_path(tmp_path / "new" / "folder" / "a.mp4").suffix == ".mp4"
   (tmp_path / "file.txt").write_text("")
-  for path, message in [(tmp_path / "a.avi", "must end in .mp4"),
-                        (tmp_path / "file.txt" / "a.mp4", "is not a folder")]:
+  for path, message in [
+    (tmp_path / "a.avi", "must end in .mp4"),
+    (tmp_path / "file.txt" / "a.mp4", "is not a folder"),
+  ]:
     with pytest.raises(ValueError, match=message):
       options.check_video_path(path)
   (tmp_path / "folder.mp4").mkdir()
@@ -75,8 +83,10 @@ def test_cameras_frame_every_point(camera, aspect):
   assert np.all(np.abs(local[:, 1]) + padding <= depth * tan_vertical)
   assert np.all(np.abs(local[:, 0]) + padding <= depth * tan_vertical * aspect)
   # Framed tightly: some point is near an edge of the picture.
-  share = np.maximum(np.abs(local[:, 1]) / tan_vertical, np.abs(local[:, 0]) / tan_vertical /
-                     aspect) / depth
+  share = (
+    np.maximum(np.abs(local[:, 1]) / tan_vertical, np.abs(local[:, 0]) / tan_vertical / aspect)
+    / depth
+  )
   assert share.max() > 0.7
 
 
@@ -88,8 +98,9 @@ def test_markers_draw_the_trail_the_target_and_the_path_so_far():
   model = scene.scene_model(source.robot, scene.episode_points(source.episode), 64, 48)
   colours = scene.module_colours(model, source.robot.num_modules)
   assert len({tuple(colour) for colour in colours}) == source.robot.num_modules
-  drawn = markers.EpisodeMarkers(source.episode, colours, source.robot.length,
-                                 scene.arm_radius(model), "title")
+  drawn = markers.EpisodeMarkers(
+    source.episode, colours, source.robot.length, scene.arm_radius(model), "title"
+  )
   counts = []
   for time in (0.0, 2.5, 5.0):
     view = mujoco.MjvScene(model, maxgeom=drawn.geom_count)
@@ -109,8 +120,13 @@ def test_long_trails_and_paths_are_subsampled(monkeypatch):
   monkeypatch.setattr(markers, "MAX_TRAIL_MARKERS", 3)
   monkeypatch.setattr(markers, "MAX_PATH_SEGMENTS", 2)
   model = scene.scene_model(source.robot, scene.episode_points(source.episode), 64, 48)
-  drawn = markers.EpisodeMarkers(source.episode, scene.module_colours(model, 2),
-                                 source.robot.length, scene.arm_radius(model), "title")
+  drawn = markers.EpisodeMarkers(
+    source.episode,
+    scene.module_colours(model, 2),
+    source.robot.length,
+    scene.arm_radius(model),
+    "title",
+  )
   view = mujoco.MjvScene(model, maxgeom=drawn.geom_count)
   drawn.at(5.0, source.episode.poses[5, :, :3])
   drawn(None, view)
@@ -125,19 +141,29 @@ def test_caption_fits_the_frame_width(width, legend):
   source = recorded(length=5)
   model = scene.scene_model(source.robot, scene.episode_points(source.episode), 64, 48)
   title = "reference on spiral (tendon-3) seed 0, paper profile"
-  drawn = markers.EpisodeMarkers(source.episode, scene.module_colours(model, 2),
-                                 source.robot.length, scene.arm_radius(model), title)
+  drawn = markers.EpisodeMarkers(
+    source.episode,
+    scene.module_colours(model, 2),
+    source.robot.length,
+    scene.arm_radius(model),
+    title,
+  )
   drawn.at(5.0, source.episode.poses[5, :, :3])
   caption = {overlay.position: overlay for overlay in drawn.caption(360, width, UNIFORM_FONT)}
   top = caption[mujoco.mjtGridPos.mjGRID_TOPLEFT]
   assert top.title.split() == title.split()  # Every word, wrapped between words only.
-  assert all(markers.overlay_width(line, "", UNIFORM_FONT) <= width
-             for line in top.title.split("\n"))
-  bottom = [caption[position] for position in (mujoco.mjtGridPos.mjGRID_BOTTOMLEFT,
-                                               mujoco.mjtGridPos.mjGRID_BOTTOMRIGHT)
-            if position in caption]
-  assert sum(markers.overlay_width(overlay.title, overlay.body, UNIFORM_FONT)
-             for overlay in bottom) <= width
+  assert all(
+    markers.overlay_width(line, "", UNIFORM_FONT) <= width for line in top.title.split("\n")
+  )
+  bottom = [
+    caption[position]
+    for position in (mujoco.mjtGridPos.mjGRID_BOTTOMLEFT, mujoco.mjtGridPos.mjGRID_BOTTOMRIGHT)
+    if position in caption
+  ]
+  assert (
+    sum(markers.overlay_width(overlay.title, overlay.body, UNIFORM_FONT) for overlay in bottom)
+    <= width
+  )
   if legend is not None:
     assert (len(bottom) == 2) == legend
 
@@ -155,8 +181,9 @@ def test_frames_show_the_arm_moving_with_the_first_backend_that_works(monkeypatc
   source = recorded(robot="tendon-2", task="circle", agent="random", length=3)
   monkeypatch.setenv("MUJOCO_GL", "no-such-backend")  # Fails; egl or osmesa takes over.
   assert video.backend_candidates()[0] == "no-such-backend"
-  stats = video.render(source, tmp_path / "frames.npy",
-                       options.VideoOptions(width=96, height=72, frames_per_step=2))
+  stats = video.render(
+    source, tmp_path / "frames.npy", options.VideoOptions(width=96, height=72, frames_per_step=2)
+  )
   assert stats.backend in video.OFFSCREEN_BACKENDS
   frames = np.load(stats.path)
   assert frames.shape == (1 + 3 * 2, 72, 96, 3) and frames.dtype == np.uint8
@@ -176,8 +203,21 @@ def test_frames_show_the_arm_moving_with_the_first_backend_that_works(monkeypatc
     video.render(source, tmp_path / "frames.npy", SMALL)
 
 
-RENDER = ["render", "--task", "circle", "--agent", "zero", "--robot", "tendon-2", "--profile",
-          "tiny", "--width", "64", "--height", "48"]
+RENDER = [
+  "render",
+  "--task",
+  "circle",
+  "--agent",
+  "zero",
+  "--robot",
+  "tendon-2",
+  "--profile",
+  "tiny",
+  "--width",
+  "64",
+  "--height",
+  "48",
+]
 
 
 def test_cli_render_writes_an_mp4_that_decodes(tmp_path, capsys):
@@ -192,8 +232,10 @@ def test_cli_render_writes_an_mp4_that_decodes(tmp_path, capsys):
   assert [p.name for p in out.parent.iterdir()] == ["zero.mp4"]  # No temporary file left.
 
 
-@pytest.mark.skipif("osmesa" not in softbench.installed_headless_backends(),
-                    reason="OSMesa is not installed (Debian: libosmesa6)")
+@pytest.mark.skipif(
+  "osmesa" not in softbench.installed_headless_backends(),
+  reason="OSMesa is not installed (Debian: libosmesa6)",
+)
 def test_cli_render_falls_back_to_osmesa_when_egl_cannot_open(tmp_path, launch_with_broken_egl):
   out = tmp_path / "zero.mp4"
   result = launch_with_broken_egl([*RENDER, "--out", str(out)])
@@ -202,25 +244,45 @@ def test_cli_render_falls_back_to_osmesa_when_egl_cannot_open(tmp_path, launch_w
   assert imageio_ffmpeg.count_frames_and_secs(str(out))[0] == 5
 
 
-@pytest.mark.parametrize("extra,message", [
-    (["--width", "641"], "even number"), (["--width", "wide"], "width must be a number"),
-    (["--height", "0"], "even number"), (["--fps", "0"], "fps must be"),
-    (["--camera", "nope"], "unknown camera"), (["--frames-per-step", "0"], "frames per step"),
+@pytest.mark.parametrize(
+  "extra,message",
+  [
+    (["--width", "641"], "even number"),
+    (["--width", "wide"], "width must be a number"),
+    (["--height", "0"], "even number"),
+    (["--fps", "0"], "fps must be"),
+    (["--camera", "nope"], "unknown camera"),
+    (["--frames-per-step", "0"], "frames per step"),
     (["--seed", "-1"], "seed must be"),
-])
+  ],
+)
 def test_cli_render_refuses_bad_input_with_one_line(extra, message, tmp_path, capsys):
   assert cli.main([*RENDER, "--out", str(tmp_path / "a.mp4"), *extra]) == cli.EXIT_USAGE
   lines = capsys.readouterr().err.strip().splitlines()
   assert len(lines) == 1 and message in lines[0]
 
 
-@pytest.mark.parametrize("out,message", [("a.gif", "must end in .mp4"),
-                                         ("file.txt/a.mp4", "is not a folder")])
+@pytest.mark.parametrize(
+  "out,message", [("a.gif", "must end in .mp4"), ("file.txt/a.mp4", "is not a folder")]
+)
 def test_cli_refuses_unwritable_video_paths(out, message, tmp_path, capsys):
   (tmp_path / "file.txt").write_text("")
-  for argv in ([*RENDER, "--out", str(tmp_path / out)],
-               ["run", "--task", "circle", "--agent", "zero", "--profile", "tiny",
-                "--results", str(tmp_path), "--video", str(tmp_path / out)]):
+  for argv in (
+    [*RENDER, "--out", str(tmp_path / out)],
+    [
+      "run",
+      "--task",
+      "circle",
+      "--agent",
+      "zero",
+      "--profile",
+      "tiny",
+      "--results",
+      str(tmp_path),
+      "--video",
+      str(tmp_path / out),
+    ],
+  ):
     assert cli.main(argv) == cli.EXIT_USAGE
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and message in lines[0]

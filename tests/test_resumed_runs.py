@@ -100,11 +100,17 @@ def test_a_failed_save_warns_and_the_run_goes_on(monkeypatch):
 
 
 def test_other_settings_never_reuse_saved_seeds(monkeypatch):
-  folders = {episode_snapshots.folder(settings) for settings in (
-      tiny_run(), tiny_run("zero"),
-      run.settings("circle", "random", "tendon-1", seeds=SEEDS, profile="tiny",
-                   eval_mode="open-loop"),
-      run.settings("circle", "random", "tendon-2", seeds=SEEDS, profile="tiny"))}
+  folders = {
+    episode_snapshots.folder(settings)
+    for settings in (
+      tiny_run(),
+      tiny_run("zero"),
+      run.settings(
+        "circle", "random", "tendon-1", seeds=SEEDS, profile="tiny", eval_mode="open-loop"
+      ),
+      run.settings("circle", "random", "tendon-2", seeds=SEEDS, profile="tiny"),
+    )
+  }
   assert len(folders) == 4
   monkeypatch.setattr(episode_snapshots, "_device", lambda: "cuda")  # Another device.
   assert episode_snapshots.folder(tiny_run()) not in folders
@@ -120,8 +126,21 @@ def test_an_edited_trajectory_file_never_reuses_saved_seeds(tmp_path):
 
 
 def test_a_failed_record_write_keeps_the_seeds_for_the_next_run(monkeypatch, tmp_path, capsys):
-  argv = ["run", "--task", "circle", "--agent", "random", "--robot", "tendon-1", "--seeds",
-          str(SEEDS), "--profile", "tiny", "--results", str(tmp_path / "records")]
+  argv = [
+    "run",
+    "--task",
+    "circle",
+    "--agent",
+    "random",
+    "--robot",
+    "tendon-1",
+    "--seeds",
+    str(SEEDS),
+    "--profile",
+    "tiny",
+    "--results",
+    str(tmp_path / "records"),
+  ]
 
   def disk_full(record, path):
     raise OSError(28, "No space left on device", str(path))

@@ -25,8 +25,14 @@ from softbench.robots import tendon_family
 from softbench.robots.physics import SoftArmPhysics
 
 # Object kind (the MjModel accessor) and the MjModel attribute that counts them.
-NAMED_OBJECTS = {"body": "nbody", "joint": "njnt", "geom": "ngeom", "site": "nsite",
-                 "tendon": "ntendon", "actuator": "nu"}
+NAMED_OBJECTS = {
+  "body": "nbody",
+  "joint": "njnt",
+  "geom": "ngeom",
+  "site": "nsite",
+  "tendon": "ntendon",
+  "actuator": "nu",
+}
 WARNINGS = [kind for name, kind in mujoco.mjtWarning.__members__.items() if name != "mjNWARNING"]
 
 RANDOM_ACTUATION_S = 10.0
@@ -71,9 +77,14 @@ def _expected_size(name: str) -> tuple[int, int]:
 def _robots(xfail: dict[str, str] | None = None) -> list:
   """``BENCHMARK_ROBOTS`` as pytest params; ``xfail`` maps a name to a known, measured failure."""
   xfail = xfail or {}
-  return [pytest.param(name, id=name, marks=[pytest.mark.xfail(strict=True, reason=xfail[name])]
-                       if name in xfail else [])
-          for name in BENCHMARK_ROBOTS]
+  return [
+    pytest.param(
+      name,
+      id=name,
+      marks=[pytest.mark.xfail(strict=True, reason=xfail[name])] if name in xfail else [],
+    )
+    for name in BENCHMARK_ROBOTS
+  ]
 
 
 def new_physics(robot) -> SoftArmPhysics:
@@ -179,7 +190,8 @@ def test_random_actuation_is_stable(robot_name):
     for chunk in np.array_split(np.arange(per_action), 10):  # Checks 10 times per action.
       advance(physics, nstep=len(chunk))
       assert np.all(np.isfinite(data.qpos)) and np.all(np.isfinite(data.qvel)), (
-          f"non-finite state at t = {data.time:.3f} s")
+        f"non-finite state at t = {data.time:.3f} s"
+      )
       farthest = max(farthest, float(np.linalg.norm(tips(physics)[-1])))
   raised = {kind.name: data.warning[kind].number for kind in WARNINGS if data.warning[kind].number}
   assert not raised, f"MuJoCo warnings: {raised}"
@@ -208,8 +220,10 @@ def test_rests_at_zero_action(robot_name):
   advance(physics, REST_S)
   sag = np.linalg.norm(settled - start, axis=1).max()
   drift = np.linalg.norm(tips(physics) - settled, axis=1).max()
-  figures = (f"after {REST_S} s: max |qvel| = {max_qvel:.3g}, sag {sag * 1e3:.3f} mm; "
-             f"then drift {drift * 1e3:.4f} mm")
+  figures = (
+    f"after {REST_S} s: max |qvel| = {max_qvel:.3g}, sag {sag * 1e3:.3f} mm; "
+    f"then drift {drift * 1e3:.4f} mm"
+  )
   assert max_qvel < REST_MAX_QVEL, figures
   assert sag < REST_MAX_SAG_FRACTION * robot.length, figures
   assert drift < REST_MAX_TIP_DRIFT, figures
@@ -229,7 +243,8 @@ def test_returns_to_rest_after_a_step(robot_name):
     advance(physics, RETURN_S)
     error = np.linalg.norm(tips(physics) - rest, axis=1).max()
     assert error < RETURN_TOLERANCE, (
-        f"{error * 1e3:.3f} mm from rest {RETURN_S} s after releasing {np.round(action, 3)}")
+      f"{error * 1e3:.3f} mm from rest {RETURN_S} s after releasing {np.round(action, 3)}"
+    )
 
 
 # 4. Mirror symmetry.
@@ -265,15 +280,19 @@ def test_bending_grows_with_actuation(robot_name):
       angles.append(np.degrees(np.arccos(np.clip(axis @ rest[module - 1], -1.0, 1.0))))
     assert angles[0] > 1.0, f"module {module}: {angles[0]:.2f} deg at level {BEND_LEVELS[0]}"
     assert np.all(np.diff(angles) > 0), (
-        f"module {module} bend angles (deg) not increasing: {np.round(angles, 2).tolist()}")
+      f"module {module} bend angles (deg) not increasing: {np.round(angles, 2).tolist()}"
+    )
 
 
 # 5b. Where a module's actuators act: within the module, or through the proximal ones too.
 
 
 def _multi_module_tendon_arms() -> list:
-  return [pytest.param(name, id=name) for name in BENCHMARK_ROBOTS
-          if tendon_family(name) and make(name).num_modules > 1]
+  return [
+    pytest.param(name, id=name)
+    for name in BENCHMARK_ROBOTS
+    if tendon_family(name) and make(name).num_modules > 1
+  ]
 
 
 @pytest.mark.parametrize("robot_name", _multi_module_tendon_arms())
@@ -282,9 +301,10 @@ def test_a_module_turns_the_proximal_ones_as_its_family_routes_cables(robot_name
   low, high = PROXIMAL_TILT_DEG[tendon_family(robot_name).FAMILY]
   for module in range(2, robot.num_modules + 1):
     tilts = measure.gravity_free_tilts(robot, module)
-    proximal = tilts[:module - 1]
+    proximal = tilts[: module - 1]
     assert low <= proximal.min() and proximal.max() <= high, (
-        f"module {module} turns the tips by {np.round(tilts, 2).tolist()} deg")
+      f"module {module} turns the tips by {np.round(tilts, 2).tolist()} deg"
+    )
     assert tilts[module - 1] > 45.0, f"module {module}'s own tip turns {tilts[module - 1]:.1f} deg"
 
 
@@ -292,14 +312,17 @@ def test_a_one_module_local_arm_is_the_one_module_arm():
   # Module 1's cables start at the clamp in both families; only their hole names differ.
   local, crossing = make("tendon-local-1"), make("tendon-1")
   for action in _random_actions(local, 3, seed=4) + [np.ones(2)]:
-    np.testing.assert_array_equal(settle(local, action, 1.0).module_poses(),
-                                  settle(crossing, action, 1.0).module_poses())
+    np.testing.assert_array_equal(
+      settle(local, action, 1.0).module_poses(), settle(crossing, action, 1.0).module_poses()
+    )
 
 
 # 6. Bad input.
 
 
-@pytest.mark.parametrize("name, overrides", [
+@pytest.mark.parametrize(
+  "name, overrides",
+  [
     ("tendon-0", {}),
     ("tendon-x", {}),
     ("tendon-1000", {}),
@@ -323,7 +346,9 @@ def test_a_one_module_local_arm_is_the_one_module_arm():
     ("tendon-" + "9" * 5000, {}),
     ("tendon-1", {"num_modules": 0}),  # The name gives the count.
     ("tendon-1", {"num_modules": 2}),
-], ids=lambda value: repr(value)[:40])
+  ],
+  ids=lambda value: repr(value)[:40],
+)
 def test_bad_robot_raises_one_line_value_error(name, overrides):
   with pytest.raises(ValueError) as caught:
     make(name, **overrides)
@@ -347,8 +372,19 @@ def test_set_action_rejects_bad_actions(robot_name):
   high[0] = 1.01
   low = valid.copy()
   low[-1] = -1.5
-  for bad in (nan, inf, high, low, np.zeros(dim + 1), np.zeros(dim - 1), np.zeros((1, dim)),
-              np.float64(0.0), valid + 0.1j, np.ones(dim, dtype=bool), np.array(["0.5"] * dim)):
+  for bad in (
+    nan,
+    inf,
+    high,
+    low,
+    np.zeros(dim + 1),
+    np.zeros(dim - 1),
+    np.zeros((1, dim)),
+    np.float64(0.0),
+    valid + 0.1j,
+    np.ones(dim, dtype=bool),
+    np.array(["0.5"] * dim),
+  ):
     with pytest.raises(ValueError) as caught:
       physics.set_action(bad)
     assert "\n" not in str(caught.value)
@@ -366,7 +402,8 @@ def test_every_tendon_arm_builds(family, num_modules):
   assert model.nu == model.ntendon == 4 * num_modules
   tip_sites = [f"module{k}_tip" for k in range(1, num_modules + 1)]
   assert [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, s) >= 0 for s in tip_sites] == (
-      [True] * num_modules)
+    [True] * num_modules
+  )
   assert robot.length == pytest.approx(0.05 * num_modules)
 
 
@@ -404,8 +441,11 @@ def _module_series_compliance(model: mujoco.MjModel, module: int, kind: str) -> 
   """Sum of 1 / stiffness over a module's joints of ``kind`` ("slide" or "ball"): the compliance
   of those springs in series; 0 when the module has none or they carry no stiffness."""
   names = [model.joint(j).name for j in range(model.njnt)]
-  stiffness = [model.jnt_stiffness[j] for j, name in enumerate(names)
-               if name.startswith(f"module{module}_segment") and name.endswith(f"_{kind}")]
+  stiffness = [
+    model.jnt_stiffness[j]
+    for j, name in enumerate(names)
+    if name.startswith(f"module{module}_segment") and name.endswith(f"_{kind}")
+  ]
   return float(sum(1.0 / k for k in stiffness if k > 0))
 
 
@@ -416,9 +456,11 @@ def _rod_segments(model: mujoco.MjModel, module: int) -> list[int]:
 
 # Every backbone the robots build: the cable plugin (tendon arms' default), ball-joint springs
 # (``backbone="joints"``) and the pneumatic arm's ball and slide springs.
-_BACKBONES = ([pytest.param(name, {}, id=name) for name in BENCHMARK_ROBOTS]
-              + [pytest.param(name, {"backbone": "joints"}, id=f"{name}-joints")
-                 for name in BENCHMARK_ROBOTS if name.startswith("tendon-")])
+_BACKBONES = [pytest.param(name, {}, id=name) for name in BENCHMARK_ROBOTS] + [
+  pytest.param(name, {"backbone": "joints"}, id=f"{name}-joints")
+  for name in BENCHMARK_ROBOTS
+  if name.startswith("tendon-")
+]
 
 
 @pytest.mark.parametrize("robot_name, overrides", _BACKBONES)
@@ -441,14 +483,20 @@ def test_refining_keeps_every_module_material(robot_name, overrides, factor):
       segments = _rod_segments(model, module)
       assert len(segments) == robot.segments_per_module * (1 if model is coarse else factor)
       assert {int(model.body_plugin[b]) >= 0 for b in segments} == {coarse.nplugin > 0}, module
-      radii.append({float(model.geom_size[g][0]) for g in range(model.ngeom)
-                    if model.geom_bodyid[g] in segments})
+      radii.append(
+        {
+          float(model.geom_size[g][0])
+          for g in range(model.ngeom)
+          if model.geom_bodyid[g] in segments
+        }
+      )
     assert len(radii[0]) == 1 and radii[1] == radii[0], (module, radii)
     if coarse.nplugin == 0:  # Springs carry the elasticity: every module has bending springs.
       assert _module_series_compliance(coarse, module, "ball") > 0, module
     for kind in ("slide", "ball"):
       assert _module_series_compliance(fine, module, kind) == pytest.approx(
-          _module_series_compliance(coarse, module, kind), rel=1e-5), (module, kind)
+        _module_series_compliance(coarse, module, kind), rel=1e-5
+      ), (module, kind)
 
 
 # 8. Exported XML.
@@ -463,5 +511,6 @@ def test_exported_xml_round_trips(robot_name):
     assert getattr(reloaded, size) == getattr(model, size), size
   np.testing.assert_allclose(reloaded.body_mass, model.body_mass, rtol=1e-6)
   # The XML writer rounds the last bit of some numbers (0.055999999999999994 -> 0.056).
-  np.testing.assert_allclose(reloaded.numeric("action_map").data,
-                             model.numeric("action_map").data, rtol=1e-12, atol=0)
+  np.testing.assert_allclose(
+    reloaded.numeric("action_map").data, model.numeric("action_map").data, rtol=1e-12, atol=0
+  )

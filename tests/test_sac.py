@@ -30,6 +30,7 @@ def home(tmp_path, monkeypatch):
 
 def _weights(trained: dict) -> dict[str, torch.Tensor]:
   import io  # pylint: disable=import-outside-toplevel
+
   return stable_baselines3.SAC.load(io.BytesIO(trained["model"])).policy.state_dict()
 
 
@@ -87,9 +88,12 @@ def test_training_episodes_follow_training_stretches_fixed_by_the_seed(home):
     observation, _ = env.reset()
     targets, _ = env.window(episode)
     windows.append(targets)
-    np.testing.assert_array_equal(observation[env.observation_space.shape[0] - arm.action_dim
-                                              - targets[0].size:-arm.action_dim],
-                                  targets[0].ravel())
+    np.testing.assert_array_equal(
+      observation[
+        env.observation_space.shape[0] - arm.action_dim - targets[0].size : -arm.action_dim
+      ],
+      targets[0].ravel(),
+    )
     assert all(np.any(np.all(training_poses == pose, axis=(1, 2))) for pose in targets)
   np.testing.assert_array_equal(later.reset()[0], env.__class__(arm, stream, 10, 4, 2).reset()[0])
   assert not np.array_equal(windows[0], windows[1])
@@ -99,8 +103,11 @@ def test_training_episodes_follow_training_stretches_fixed_by_the_seed(home):
 
 def test_policy_input_scales_positions_only():
   shapes = {"poses": (2, 6), "target": (1, 3), "previous_action": (4,)}
-  named = {"poses": np.arange(12.0).reshape(2, 6), "target": np.array([[1.0, 2.0, 3.0]]),
-           "previous_action": np.array([0.5, -0.5, 1.0, 0.0])}
+  named = {
+    "poses": np.arange(12.0).reshape(2, 6),
+    "target": np.array([[1.0, 2.0, 3.0]]),
+    "previous_action": np.array([0.5, -0.5, 1.0, 0.0]),
+  }
   scaled = sac.policy_input(environment.flatten(named), shapes, length=2.0)
   assert scaled.dtype == np.float32
   np.testing.assert_array_equal(scaled[:12], [0, 0.5, 1, 3, 4, 5, 3, 3.5, 4, 9, 10, 11])

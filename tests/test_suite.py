@@ -8,9 +8,9 @@ import json
 import re
 import warnings
 
+from dm_env import specs
 import numpy as np
 import pytest
-from dm_env import specs
 
 from softbench import agents
 from softbench import cli
@@ -35,10 +35,13 @@ def shared_cache(tmp_path_factory, monkeypatch):
 
 def short_env(robot, task, seed=0, **options):
   if task == "custom":
-    options = {"trajectory": references.reference(robots.make(robot), "circle", 3).targets,
-               **options}
-  return suite.load(robot, task, seed=seed,
-                    **{**suite.length_options(task, SHORT_STEPS), **options})
+    options = {
+      "trajectory": references.reference(robots.make(robot), "circle", 3).targets,
+      **options,
+    }
+  return suite.load(
+    robot, task, seed=seed, **{**suite.length_options(task, SHORT_STEPS), **options}
+  )
 
 
 def random_actions(env, seed=0):
@@ -62,9 +65,9 @@ def run_episode(env, seed=0):
 
 @pytest.mark.parametrize("robot,task", EVERY_TASK)
 class TestEveryTask:
-
-  def test_observations_match_specs_rewards_lie_in_unit_interval_and_episode_ends(self, robot,
-                                                                                  task):
+  def test_observations_match_specs_rewards_lie_in_unit_interval_and_episode_ends(
+    self, robot, task
+  ):
     env = short_env(robot, task)
     observation_spec = env.observation_spec()
     observations, rewards = run_episode(env)
@@ -134,8 +137,9 @@ def test_bend_amplitude_bends_the_end_effector_by_the_stated_angle(robot):
 
 def test_reference_shapes_differ_and_stay_in_unit_actuation():
   arm = robots.make("pneumatic-433")
-  actions = {shape: references.pattern_actions(arm, shape, 50, amplitude=0.5)
-             for shape in references.SHAPES}
+  actions = {
+    shape: references.pattern_actions(arm, shape, 50, amplitude=0.5) for shape in references.SHAPES
+  }
   for shape, action in actions.items():
     assert action.shape == (50, arm.action_dim)
     assert np.all(np.abs(action) <= 1.0), shape
@@ -171,10 +175,12 @@ def test_reference_is_cached_and_a_corrupt_cache_is_regenerated(monkeypatch, tmp
   assert meta["config"]["shape"] == "circle"
 
 
-@pytest.mark.parametrize("description", ["[]", "null", '"text"', '{"config": 1}', "{", "",
-                                         "[" * 100_000])
-def test_a_malformed_cached_reference_description_is_regenerated(description, monkeypatch,
-                                                                  tmp_path):
+@pytest.mark.parametrize(
+  "description", ["[]", "null", '"text"', '{"config": 1}', "{", "", "[" * 100_000]
+)
+def test_a_malformed_cached_reference_description_is_regenerated(
+  description, monkeypatch, tmp_path
+):
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
   arm = robots.make("tendon-1")
   first = references.reference(arm, "circle", length=4)
@@ -200,10 +206,12 @@ def test_a_damaged_reference_warns_on_one_softbench_line(monkeypatch, tmp_path):
   monkeypatch.setattr(warnings, "formatwarning", warnings.formatwarning)
   parallel_seeds.one_line_warnings()  # As the command line prints warnings.
   (warning,) = caught
-  printed = warnings.formatwarning(warning.message, warning.category, warning.filename,
-                                   warning.lineno)
-  assert printed.startswith(f"softbench: warning: {meta.with_suffix('.npz')}: unreadable "
-                            f"cached reference (")
+  printed = warnings.formatwarning(
+    warning.message, warning.category, warning.filename, warning.lineno
+  )
+  assert printed.startswith(
+    f"softbench: warning: {meta.with_suffix('.npz')}: unreadable cached reference ("
+  )
   assert printed.count("\n") == 1 and printed.endswith("; generating it again\n")
 
 
@@ -233,7 +241,6 @@ def test_reward_is_one_on_target_and_falls_with_distance():
 
 
 class TestCustomTrajectory:
-
   @pytest.fixture
   def rows(self):
     arm = robots.make("tendon-2")
@@ -252,7 +259,9 @@ class TestCustomTrajectory:
     np.testing.assert_allclose(from_file, from_array, atol=1e-15)
     assert suite.load("tendon-2", "custom", trajectory=path).task.num_steps == 4
 
-  @pytest.mark.parametrize("change,message", [
+  @pytest.mark.parametrize(
+    "change,message",
+    [
       (lambda rows: rows[:, :6], r"\(steps, 12\)"),
       (lambda rows: rows[0], r"\(steps, 12\)"),
       (lambda rows: rows[:0], "no rows"),
@@ -260,7 +269,8 @@ class TestCustomTrajectory:
       (lambda rows: rows * 2, "unit length"),
       (lambda rows: np.where(np.arange(12) < 3, 1e300, rows), "arm lengths"),
       (lambda rows: np.where(np.arange(12) == 2, -0.5, rows), "arm lengths"),  # 500 mm, 100 long.
-  ])
+    ],
+  )
   def test_malformed_trajectory_gets_a_clear_error(self, rows, change, message):
     with pytest.raises(ValueError, match=message):
       suite.load("tendon-2", "custom", trajectory=change(rows))
@@ -283,7 +293,9 @@ class TestCustomTrajectory:
       suite.load("tendon-2", "custom")
 
 
-@pytest.mark.parametrize("call,message", [
+@pytest.mark.parametrize(
+  "call,message",
+  [
     (lambda: suite.load("tendon-3", "juggle"), "unknown task 'juggle'"),
     (lambda: suite.load("octopus-8", "circle"), "unknown robot"),
     (lambda: suite.load("tendon-11", "circle"), "1 to 10 modules"),
@@ -292,7 +304,8 @@ class TestCustomTrajectory:
     (lambda: suite.load("tendon-3", "reach", module=4), "module must be 1 to 3"),
     (lambda: suite.load("tendon-3", "reach", steps=0), "positive integer"),
     (lambda: suite.load("tendon-3", "circle", length=2, initial_actuation=2.0), r"\[0, 1\]"),
-])
+  ],
+)
 def test_bad_arguments_get_one_line_errors(call, message):
   with pytest.raises(ValueError, match=message) as error:
     call()
@@ -313,20 +326,37 @@ BAD_SEEDS = [2**32, 2**70, -1, "x", 1.5, True]
 @pytest.mark.parametrize("entry", ["suite.load", "data.collect", "agents.make"])
 def test_one_seed_rule_everywhere(entry, seed, monkeypatch, tmp_path):
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
-  calls = {"suite.load": lambda: suite.load("tendon-1", "circle", seed=seed, length=3),
-           "data.collect": lambda: data.collect("tendon-1", samples=4, seed=seed,
-                                                progress=False),
-           "agents.make": lambda: agents.make("zero", "tendon-1", seed)}
+  calls = {
+    "suite.load": lambda: suite.load("tendon-1", "circle", seed=seed, length=3),
+    "data.collect": lambda: data.collect("tendon-1", samples=4, seed=seed, progress=False),
+    "agents.make": lambda: agents.make("zero", "tendon-1", seed),
+  }
   with pytest.raises(ValueError, match=r"^seed must be an integer from 0 to 4294967295, got "):
     calls[entry]()
   assert not (tmp_path / "datasets").exists()
 
 
-@pytest.mark.parametrize("command", [["collect", "--robot", "tendon-1", "--seed"],
-                                     ["render", "--task", "circle", "--agent", "zero", "--robot",
-                                      "tendon-1", "--out", "never.mp4", "--seed"]])
+@pytest.mark.parametrize(
+  "command",
+  [
+    ["collect", "--robot", "tendon-1", "--seed"],
+    [
+      "render",
+      "--task",
+      "circle",
+      "--agent",
+      "zero",
+      "--robot",
+      "tendon-1",
+      "--out",
+      "never.mp4",
+      "--seed",
+    ],
+  ],
+)
 def test_the_cli_takes_seeds_by_the_same_rule(command, capsys, tmp_path, monkeypatch):
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
   assert cli.main([*command, str(2**70)]) == cli.EXIT_USAGE
-  assert capsys.readouterr().err == ("softbench: error: seed must be an integer from 0 to "
-                                     f"4294967295, got {2**70}\n")
+  assert capsys.readouterr().err == (
+    f"softbench: error: seed must be an integer from 0 to 4294967295, got {2**70}\n"
+  )

@@ -25,9 +25,22 @@ def shared_home(tmp_path_factory, monkeypatch):
 
 
 def tune(tmp_path, *options, agent="mlp", trials=2):
-  return cli.main(["tune", "--agent", agent, "--robot", "tendon-2", "--profile", "tiny",
-                   "--trials", str(trials), "--storage", f"sqlite:///{tmp_path / 'studies.db'}",
-                   *options])
+  return cli.main(
+    [
+      "tune",
+      "--agent",
+      agent,
+      "--robot",
+      "tendon-2",
+      "--profile",
+      "tiny",
+      "--trials",
+      str(trials),
+      "--storage",
+      f"sqlite:///{tmp_path / 'studies.db'}",
+      *options,
+    ]
+  )
 
 
 def test_study_runs_resumes_and_writes_its_summary(tmp_path, capsys):
@@ -40,8 +53,9 @@ def test_study_runs_resumes_and_writes_its_summary(tmp_path, capsys):
   previous = hyperparameters.values("mlp", "tendon-2")
   assert first["previous_values"]["params"] == previous  # Trial 0: the values in use.
   assert first["trial_table"][0]["params"] == previous
-  assert first["best"]["value"] == min(row["value"] for row in first["trial_table"]
-                                       if row["state"] == "complete")
+  assert first["best"]["value"] == min(
+    row["value"] for row in first["trial_table"] if row["state"] == "complete"
+  )
   assert f"best trial {first['best']['trial']}: validation MSE" in out
   assert str(summary_file) in out
 
@@ -55,14 +69,27 @@ def test_study_runs_resumes_and_writes_its_summary(tmp_path, capsys):
   # Trial n's sampler is seeded with n: the resumed study is the one run in one go.
   at_once = tmp_path / "at_once.json"
   assert tune(tmp_path, "--study", "at-once", "--summary", str(at_once), trials=3) == 0
-  assert ([row["params"] for row in json.loads(at_once.read_text())["trial_table"]]
-          == [row["params"] for row in resumed["trial_table"]])
+  assert [row["params"] for row in json.loads(at_once.read_text())["trial_table"]] == [
+    row["params"] for row in resumed["trial_table"]
+  ]
 
 
 def test_confirm_trains_the_choice_at_the_full_epoch_budget(tmp_path, capsys):
   summary_file = tmp_path / "confirmed.json"
-  assert tune(tmp_path, "--study", "short", "--epochs", "1", "--confirm", "--summary",
-              str(summary_file), trials=1) == 0
+  assert (
+    tune(
+      tmp_path,
+      "--study",
+      "short",
+      "--epochs",
+      "1",
+      "--confirm",
+      "--summary",
+      str(summary_file),
+      trials=1,
+    )
+    == 0
+  )
   summary = json.loads(summary_file.read_text())
   assert summary["trial_epochs"] == 1 and summary["max_epochs"] == 2
   check = summary["full_budget"]
@@ -82,7 +109,8 @@ def test_adopt_commits_the_best_values_with_the_summary(tmp_path, monkeypatch, c
   assert entry["params"] == summary["best"]["params"]
   assert entry["study"]["best"] == summary["best"] and "trial_table" not in entry["study"]
   assert hyperparameters.values("smpl", "tendon-3") == hyperparameters.values(
-      "smpl", "tendon-3", path=hyperparameters.PATH)  # Other robots keep theirs.
+    "smpl", "tendon-3", path=hyperparameters.PATH
+  )  # Other robots keep theirs.
 
 
 @pytest.mark.parametrize("agent", LEARNED)
@@ -110,8 +138,11 @@ def test_committed_values_fit_every_learned_agent(agent):
 def test_a_changed_value_changes_the_checkpoint_key(agent, tmp_path, monkeypatch):
   arm, profile = robots.make("tendon-3"), profiles.get("tiny")
   views = tuning.study.learner(agent).views(arm)
-  key = lambda: learned.trained_config(agent, arm, views, 0, profile,
-                                       hyperparameters.values(agent, arm.name)).key
+  key = lambda: (
+    learned.trained_config(
+      agent, arm, views, 0, profile, hyperparameters.values(agent, arm.name)
+    ).key
+  )
   before = key()
   table = json.loads(hyperparameters.PATH.read_text())
   params = table["agents"][agent]["tendon-3"]["params"]
@@ -135,17 +166,28 @@ def test_learned_agents_train_with_the_committed_values(tmp_path, monkeypatch):
   assert len(list((tmp_path / "home" / learned.CHECKPOINT_FOLDER).glob("mlp-*.pt"))) == 2
 
 
-@pytest.mark.parametrize("change,message", [
-    (lambda t: t["agents"]["mlp"]["tendon-3"]["params"].update(learning_rate=1.0),
-     "learning_rate = 1.0 is outside its range"),
-    (lambda t: t["agents"]["lstm"]["tendon-3"]["params"].update(batch_size=32.0),
-     "batch_size = 32.0 is outside its range"),
-    (lambda t: t["agents"]["smpl"]["tendon-3"]["params"].update(hidden_size=64),
-     "hyperparameters must be"),
-    (lambda t: t["agents"].update(oracle={"tendon-3": {"params": {}, "study": None}}),
-     "agent 'oracle' has no hyperparameters to tune"),
+@pytest.mark.parametrize(
+  "change,message",
+  [
+    (
+      lambda t: t["agents"]["mlp"]["tendon-3"]["params"].update(learning_rate=1.0),
+      "learning_rate = 1.0 is outside its range",
+    ),
+    (
+      lambda t: t["agents"]["lstm"]["tendon-3"]["params"].update(batch_size=32.0),
+      "batch_size = 32.0 is outside its range",
+    ),
+    (
+      lambda t: t["agents"]["smpl"]["tendon-3"]["params"].update(hidden_size=64),
+      "hyperparameters must be",
+    ),
+    (
+      lambda t: t["agents"].update(oracle={"tendon-3": {"params": {}, "study": None}}),
+      "agent 'oracle' has no hyperparameters to tune",
+    ),
     (lambda t: t["agents"]["vae-lstm"]["tendon-3"].pop("study"), "expected the keys params"),
-])
+  ],
+)
 def test_a_bad_hyperparameters_file_is_refused_with_one_line(change, message, tmp_path):
   table = json.loads(hyperparameters.PATH.read_text())
   change(table)
@@ -156,19 +198,28 @@ def test_a_bad_hyperparameters_file_is_refused_with_one_line(change, message, tm
   assert "\n" not in str(error.value)
 
 
-@pytest.mark.parametrize("argv,message", [
+@pytest.mark.parametrize(
+  "argv,message",
+  [
     (["--agent", "oracle", "--robot", "tendon-2"], "unknown agent"),
     (["--agent", "zero", "--robot", "tendon-2"], "not trained on babbling"),
     (["--agent", "mlp", "--robot", "tendon-0"], "1 to 10 modules"),
     (["--agent", "mlp", "--robot", "tendon-2", "--trials", "0"], "trials must be"),
     (["--agent", "mlp", "--robot", "tendon-2", "--profile", "huge"], "unknown profile"),
-    (["--agent", "mlp", "--robot", "tendon-2", "--profile", "tiny", "--epochs", "3"],
-     "epochs must be a whole number from 1 to the tiny profile's 2"),
-    (["--agent", "mlp", "--robot", "tendon-2", "--storage", "not-a-url"],
-     "cannot open the study storage"),
-    (["--agent", "mlp", "--robot", "tendon-2", "--storage", "sqlite:////no/such/dir/x.db"],
-     "cannot open the study storage"),
-])
+    (
+      ["--agent", "mlp", "--robot", "tendon-2", "--profile", "tiny", "--epochs", "3"],
+      "epochs must be a whole number from 1 to the tiny profile's 2",
+    ),
+    (
+      ["--agent", "mlp", "--robot", "tendon-2", "--storage", "not-a-url"],
+      "cannot open the study storage",
+    ),
+    (
+      ["--agent", "mlp", "--robot", "tendon-2", "--storage", "sqlite:////no/such/dir/x.db"],
+      "cannot open the study storage",
+    ),
+  ],
+)
 def test_tune_refuses_bad_input_with_one_line(argv, message, capsys):
   assert cli.main(["tune", *argv]) == cli.EXIT_USAGE
   lines = capsys.readouterr().err.strip().splitlines()

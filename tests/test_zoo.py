@@ -26,8 +26,9 @@ TINY = profiles.get("tiny")
 
 def actions(agent_name, seed=0):
   agent = agents.make(agent_name, ROBOT, seed, "tiny")
-  return evaluation.run_episode(suite.load(ROBOT, "circle", seed=seed, length=4), agent,
-                                "circle").actions
+  return evaluation.run_episode(
+    suite.load(ROBOT, "circle", seed=seed, length=4), agent, "circle"
+  ).actions
 
 
 def use(monkeypatch, home, zoo_folder=None):
@@ -37,8 +38,10 @@ def use(monkeypatch, home, zoo_folder=None):
 
 def no_training(monkeypatch):
   """Makes any training or babbling collection fail the test."""
+
   def refuse(*args, **kwargs):
     raise AssertionError("trained or collected although the zoo holds the weights")
+
   monkeypatch.setattr(training, "fit", refuse)
   monkeypatch.setattr(protocols, "prepare_column", refuse)
   monkeypatch.setattr(learned.data, "collect", refuse)
@@ -57,8 +60,7 @@ def trained_zoos(tmp_path_factory):
         use(patched, base / "trained")
         trained = actions(agent_name)
         chosen = catalogue.setting(agent_name, ROBOT, None, "tiny", 1)
-        zoo.add([(path, kind) for _, path, kind in catalogue.cache_files(chosen)], {},
-                base / "zoo")
+        zoo.add([(path, kind) for _, path, kind in catalogue.cache_files(chosen)], {}, base / "zoo")
       made[agent_name] = (base / "zoo", trained)
     return made[agent_name]
 
@@ -68,17 +70,19 @@ def trained_zoos(tmp_path_factory):
 @pytest.fixture
 def zoo_of(trained_zoos, tmp_path):
   """A copy (the test's own) of ``agent_name``'s zoo, and the trained agent's actions."""
+
   def copy(agent_name):
     folder, trained = trained_zoos(agent_name)
     shutil.copytree(folder, tmp_path / "zoo")
     return tmp_path / "zoo", trained
+
   return copy
 
 
 @pytest.mark.parametrize("agent_name", LEARNED_AGENTS)
-def test_an_empty_data_home_takes_the_zoos_weights_instead_of_training(agent_name, zoo_of,
-                                                                       tmp_path, monkeypatch,
-                                                                       capsys):
+def test_an_empty_data_home_takes_the_zoos_weights_instead_of_training(
+  agent_name, zoo_of, tmp_path, monkeypatch, capsys
+):
   folder, trained = zoo_of(agent_name)
   capsys.readouterr()
   use(monkeypatch, tmp_path / "empty", folder)
@@ -89,8 +93,9 @@ def test_an_empty_data_home_takes_the_zoos_weights_instead_of_training(agent_nam
   assert line.startswith("softbench: zoo: took checkpoints/") and "instead of training" in line
 
 
-def test_a_tampered_zoo_file_is_refused_in_one_line_and_the_agent_trained(zoo_of, tmp_path,
-                                                                         monkeypatch):
+def test_a_tampered_zoo_file_is_refused_in_one_line_and_the_agent_trained(
+  zoo_of, tmp_path, monkeypatch
+):
   # The zoo checks bytes, whatever the agent: one agent shows it.
   agent_name = "mlp"
   folder, trained = zoo_of(agent_name)
@@ -107,10 +112,17 @@ def test_a_tampered_zoo_file_is_refused_in_one_line_and_the_agent_trained(zoo_of
   np.testing.assert_array_equal(retrained, trained)
 
 
-@pytest.mark.parametrize("damage", ["not json", '{"format": "softbench-zoo", "version": 1}',
-                                    '{"format": "other", "version": 1, "entries": []}'])
-def test_a_damaged_manifest_is_one_warning_and_the_agent_trains(damage, zoo_of, tmp_path,
-                                                                monkeypatch):
+@pytest.mark.parametrize(
+  "damage",
+  [
+    "not json",
+    '{"format": "softbench-zoo", "version": 1}',
+    '{"format": "other", "version": 1, "entries": []}',
+  ],
+)
+def test_a_damaged_manifest_is_one_warning_and_the_agent_trains(
+  damage, zoo_of, tmp_path, monkeypatch
+):
   folder, trained = zoo_of("mlp")
   (folder / zoo.MANIFEST).write_text(damage)
   use(monkeypatch, tmp_path / "empty", folder)
@@ -120,15 +132,17 @@ def test_a_damaged_manifest_is_one_warning_and_the_agent_trains(damage, zoo_of, 
 
 def test_a_manifest_path_outside_the_zoo_is_refused(tmp_path):
   entry = zoo.Entry("../outside.pt", "0" * 64, 1, "agent", "outside")
-  (tmp_path / zoo.MANIFEST).write_text(json.dumps(
-      {"format": zoo.FORMAT, "version": zoo.VERSION, "entries": [entry.to_json()]}))
+  (tmp_path / zoo.MANIFEST).write_text(
+    json.dumps({"format": zoo.FORMAT, "version": zoo.VERSION, "entries": [entry.to_json()]})
+  )
   with pytest.raises(ValueError, match="outside the zoo"):
     zoo.read_manifest(tmp_path)
 
 
 @pytest.mark.parametrize("agent_name", LEARNED_AGENTS)
 def test_an_unfinished_training_goes_on_from_the_zoo_in_another_home(
-    agent_name, trained_zoos, interrupted_training, tmp_path, monkeypatch, capsys):
+  agent_name, trained_zoos, interrupted_training, tmp_path, monkeypatch, capsys
+):
   _, uninterrupted = trained_zoos(agent_name)
   use(monkeypatch, tmp_path / "first")
   with interrupted_training():
@@ -137,8 +151,11 @@ def test_an_unfinished_training_goes_on_from_the_zoo_in_another_home(
   files = [(path, kind) for _, path, kind in catalogue.cache_files(chosen)]
   added, skipped = zoo.add(files, {}, tmp_path / "zoo")
   assert "training-state" in {entry.kind for entry in added}
-  assert skipped == [path for path, _ in files  # Not started when the training stopped.
-                     if not path.exists() and not path.with_suffix(zoo.PARTIAL_SUFFIX).exists()]
+  assert skipped == [
+    path
+    for path, _ in files  # Not started when the training stopped.
+    if not path.exists() and not path.with_suffix(zoo.PARTIAL_SUFFIX).exists()
+  ]
   capsys.readouterr()
   use(monkeypatch, tmp_path / "second", tmp_path / "zoo")  # Another machine's empty home.
   np.testing.assert_array_equal(actions(agent_name), uninterrupted)
@@ -158,15 +175,34 @@ def test_the_zoo_refuses_to_outgrow_its_budget(zoo_of, tmp_path, monkeypatch):
   use(monkeypatch, tmp_path / "trained")
   actions("lstm")
   with pytest.raises(ValueError, match="over its budget"):
-    zoo.add([(path, kind) for _, path, kind in catalogue.cache_files(chosen)], {}, folder,
-            budget_bytes=zoo.size_bytes(zoo.read_manifest(folder)))
+    zoo.add(
+      [(path, kind) for _, path, kind in catalogue.cache_files(chosen)],
+      {},
+      folder,
+      budget_bytes=zoo.size_bytes(zoo.read_manifest(folder)),
+    )
   assert (folder / zoo.MANIFEST).read_bytes() == before
   assert not list(folder.glob(f"{learned.CHECKPOINT_FOLDER}/lstm-*"))
 
 
 def run_command(results, seeds=2):
-  return ["run", "--task", "spiral", "--agent", "lstm", "--robot", ROBOT, "--profile", "tiny",
-          "--seeds", str(seeds), "--workers", "1", "--results", str(results)]
+  return [
+    "run",
+    "--task",
+    "spiral",
+    "--agent",
+    "lstm",
+    "--robot",
+    ROBOT,
+    "--profile",
+    "tiny",
+    "--seeds",
+    str(seeds),
+    "--workers",
+    "1",
+    "--results",
+    str(results),
+  ]
 
 
 def test_cli_run_add_and_verify_reproduce_a_record_from_the_zoo(tmp_path, monkeypatch, capsys):
@@ -174,8 +210,25 @@ def test_cli_run_add_and_verify_reproduce_a_record_from_the_zoo(tmp_path, monkey
   assert cli.main(run_command(tmp_path / "results")) == 0
   ((path, trained),) = records.read_folder(tmp_path / "results")
   folder = tmp_path / "zoo"
-  assert cli.main(["zoo", "add", "--agent", "lstm", "--robot", ROBOT, "--profile", "tiny",
-                   "--results", str(tmp_path / "results"), "--zoo", str(folder)]) == 0
+  assert (
+    cli.main(
+      [
+        "zoo",
+        "add",
+        "--agent",
+        "lstm",
+        "--robot",
+        ROBOT,
+        "--profile",
+        "tiny",
+        "--results",
+        str(tmp_path / "results"),
+        "--zoo",
+        str(folder),
+      ]
+    )
+    == 0
+  )
   entries = zoo.read_manifest(folder).values()
   assert {entry.kind for entry in entries} == {"agent", "forward"}
   assert all(entry.records == (path.name,) for entry in entries if entry.kind == "agent")
@@ -189,40 +242,74 @@ def test_cli_run_add_and_verify_reproduce_a_record_from_the_zoo(tmp_path, monkey
   assert len(rescored["zoo"]["files"]) == 2 and "zoo" not in trained
   assert not (tmp_path / "empty" / "datasets").exists()
   capsys.readouterr()
-  assert cli.main(["zoo", "verify", "--results", str(tmp_path / "results"), "--zoo",
-                   str(folder)]) == 0
+  assert (
+    cli.main(["zoo", "verify", "--results", str(tmp_path / "results"), "--zoo", str(folder)]) == 0
+  )
   out = capsys.readouterr().out
   assert out.count("identical (") == 2 and "2 of 2 re-scored seeds identical" in out
-  assert cli.main(["zoo", "verify", "--quick", "--results", str(tmp_path / "results"), "--zoo",
-                   str(folder)]) == 0
+  assert (
+    cli.main(
+      ["zoo", "verify", "--quick", "--results", str(tmp_path / "results"), "--zoo", str(folder)]
+    )
+    == 0
+  )
   assert "1 of 1 re-scored seeds identical" in capsys.readouterr().out
 
 
 def test_verify_reports_a_record_the_zoo_does_not_reproduce(tmp_path, monkeypatch, capsys):
   use(monkeypatch, tmp_path / "trained")
   assert cli.main(run_command(tmp_path / "results", seeds=1)) == 0
-  assert cli.main(["zoo", "add", "--agent", "lstm", "--robot", ROBOT, "--profile", "tiny",
-                   "--seeds", "1", "--results", str(tmp_path / "results"), "--zoo",
-                   str(tmp_path / "zoo")]) == 0
+  assert (
+    cli.main(
+      [
+        "zoo",
+        "add",
+        "--agent",
+        "lstm",
+        "--robot",
+        ROBOT,
+        "--profile",
+        "tiny",
+        "--seeds",
+        "1",
+        "--results",
+        str(tmp_path / "results"),
+        "--zoo",
+        str(tmp_path / "zoo"),
+      ]
+    )
+    == 0
+  )
   ((path, record),) = records.read_folder(tmp_path / "results")
   record["per_seed"][0]["mean_reward"] /= 2  # A record that these weights did not score.
-  records.write({key: value for key, value in record.items() if key != records.INTEGRITY_FIELD},
-                path)
+  records.write(
+    {key: value for key, value in record.items() if key != records.INTEGRITY_FIELD}, path
+  )
   capsys.readouterr()
-  assert cli.main(["zoo", "verify", "--results", str(tmp_path / "results"), "--zoo",
-                   str(tmp_path / "zoo")]) == cli.EXIT_FAILURE
+  assert (
+    cli.main(
+      ["zoo", "verify", "--results", str(tmp_path / "results"), "--zoo", str(tmp_path / "zoo")]
+    )
+    == cli.EXIT_FAILURE
+  )
   captured = capsys.readouterr()
   assert "DIFFERS: differs in mean_reward" in captured.out
   assert captured.err.strip() == "softbench: error: 1 re-scored seeds differ from their records"
   # A damaged zoo file is named before anything is re-scored.
   (checkpoint,) = (tmp_path / "zoo" / learned.CHECKPOINT_FOLDER).glob("*.pt")
   checkpoint.write_bytes(checkpoint.read_bytes()[:-1])
-  assert cli.main(["zoo", "verify", "--results", str(tmp_path / "results"), "--zoo",
-                   str(tmp_path / "zoo")]) == cli.EXIT_USAGE
+  assert (
+    cli.main(
+      ["zoo", "verify", "--results", str(tmp_path / "results"), "--zoo", str(tmp_path / "zoo")]
+    )
+    == cli.EXIT_USAGE
+  )
   assert "sha256 differs" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("argv,message", [
+@pytest.mark.parametrize(
+  "argv,message",
+  [
     (["--agent", "zero", "--robot", ROBOT], "agents trained on babbling"),
     (["--agent", "lstm", "--robot", "tendon-0"], "1 to 10 modules, got 0"),
     (["--agent", "lstm"], "name the setting"),
@@ -231,11 +318,14 @@ def test_verify_reports_a_record_the_zoo_does_not_reproduce(tmp_path, monkeypatc
     (["--family", "tendon-local"], "--family goes with --protocol"),
     (["--agent", "lstm", "--robot", ROBOT, "--seeds", "0"], "at least 1"),
     (["--agent", "lstm", "--robot", ROBOT], "nothing of this setting is trained"),
-])
+  ],
+)
 def test_zoo_add_refuses_bad_input_in_one_line(argv, message, tmp_path, monkeypatch, capsys):
   use(monkeypatch, tmp_path / "home")
-  assert cli.main(["zoo", "add", *argv, "--profile", "tiny", "--zoo",
-                   str(tmp_path / "zoo")]) == cli.EXIT_USAGE
+  assert (
+    cli.main(["zoo", "add", *argv, "--profile", "tiny", "--zoo", str(tmp_path / "zoo")])
+    == cli.EXIT_USAGE
+  )
   error = capsys.readouterr().err
   assert message in error and error.count("\n") == 1 and error.startswith("softbench: error:")
   assert not (tmp_path / "zoo" / zoo.MANIFEST).exists()
@@ -250,19 +340,47 @@ def test_zoo_commands_without_a_zoo_are_one_line_errors(tmp_path, monkeypatch, c
   monkeypatch.setenv(zoo.VARIABLE, str(tmp_path / "missing"))
   assert cli.main(["zoo", "list"]) == cli.EXIT_USAGE
   assert "no zoo at" in capsys.readouterr().err
-  assert cli.main(["zoo", "verify", "--agents", "nobody", "--zoo", str(tmp_path)]) == \
-      cli.EXIT_USAGE
+  assert cli.main(["zoo", "verify", "--agents", "nobody", "--zoo", str(tmp_path)]) == cli.EXIT_USAGE
   assert "unknown agent" in capsys.readouterr().err
 
 
 def test_exp1s_networks_come_from_the_zoo(two_stages, tmp_path, monkeypatch, capsys):
-  argv = ["run", "--protocol", "exp1s", "--agent", "smpl", "--profile", "tiny", "--seeds", "1",
-          "--workers", "1"]
+  argv = [
+    "run",
+    "--protocol",
+    "exp1s",
+    "--agent",
+    "smpl",
+    "--profile",
+    "tiny",
+    "--seeds",
+    "1",
+    "--workers",
+    "1",
+  ]
   assert cli.main([*argv, "--results", str(tmp_path / "results")]) == 0
-  ((path, trained),) = [(path, record) for path, record in
-                        records.read_folder(tmp_path / "results")]
-  assert cli.main(["zoo", "add", "--protocol", "exp1s", "--profile", "tiny", "--seeds", "1",
-                   "--results", str(tmp_path / "results"), "--zoo", str(tmp_path / "zoo")]) == 0
+  ((path, trained),) = [
+    (path, record) for path, record in records.read_folder(tmp_path / "results")
+  ]
+  assert (
+    cli.main(
+      [
+        "zoo",
+        "add",
+        "--protocol",
+        "exp1s",
+        "--profile",
+        "tiny",
+        "--seeds",
+        "1",
+        "--results",
+        str(tmp_path / "results"),
+        "--zoo",
+        str(tmp_path / "zoo"),
+      ]
+    )
+    == 0
+  )
   (entry,) = zoo.read_manifest(tmp_path / "zoo").values()
   assert entry.kind == "agent" and entry.records == (path.name,)
   use(monkeypatch, tmp_path / "empty", tmp_path / "zoo")

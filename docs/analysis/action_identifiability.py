@@ -27,8 +27,9 @@ PROBE_BATCH = 64
 PROBE_LEARNING_RATE = 1e-3
 
 
-def split_arrays(dataset: data.Dataset, split: str, modules: int,
-                 actions: slice) -> tuple[np.ndarray, np.ndarray]:
+def split_arrays(
+  dataset: data.Dataset, split: str, modules: int, actions: slice
+) -> tuple[np.ndarray, np.ndarray]:
   """(poses x_s and x_{s+1} of modules 1..``modules``, flattened; actions a_s[actions]) of one
   split, every piece end to end."""
   inputs, targets = [], []
@@ -46,8 +47,10 @@ def print_split_statistics(dataset: data.Dataset) -> None:
   for split in data.SPLITS:
     inputs, actions = split_arrays(dataset, split, dataset.num_modules, slice(None))
     tip = inputs[:, -6:-3] * 1000.0  # x_{s+1} of the last module: its position, m to mm.
-    print(f"  {split:10} tip mean {tip.mean(0)} mm, spread {tip.std(0)} mm; "
-          f"actions mean {actions.mean():.4f}, spread {actions.std():.4f}")
+    print(
+      f"  {split:10} tip mean {tip.mean(0)} mm, spread {tip.std(0)} mm; "
+      f"actions mean {actions.mean():.4f}, spread {actions.std():.4f}"
+    )
 
 
 def probe(dataset: data.Dataset, modules: int, actions: slice, seed: int) -> dict:
@@ -61,9 +64,12 @@ def probe(dataset: data.Dataset, modules: int, actions: slice, seed: int) -> dic
   x_validation = tensor((validation_inputs - mean) / std)
   a_train, a_validation = tensor(train_actions), tensor(validation_actions)
   network = torch.nn.Sequential(
-      torch.nn.Linear(x_train.shape[1], PROBE_UNITS), torch.nn.Tanh(),
-      torch.nn.Linear(PROBE_UNITS, PROBE_UNITS), torch.nn.Tanh(),
-      torch.nn.Linear(PROBE_UNITS, a_train.shape[1]))
+    torch.nn.Linear(x_train.shape[1], PROBE_UNITS),
+    torch.nn.Tanh(),
+    torch.nn.Linear(PROBE_UNITS, PROBE_UNITS),
+    torch.nn.Tanh(),
+    torch.nn.Linear(PROBE_UNITS, a_train.shape[1]),
+  )
   optimiser = torch.optim.Adam(network.parameters(), PROBE_LEARNING_RATE)
   best = {"validation": np.inf}
   for epoch in range(PROBE_EPOCHS):
@@ -74,9 +80,13 @@ def probe(dataset: data.Dataset, modules: int, actions: slice, seed: int) -> dic
     with torch.no_grad():
       residuals = (network(x_validation) - a_validation).numpy()
       train_loss = torch.mean((network(x_train) - a_train) ** 2).item()
-    if np.mean(residuals ** 2) < best["validation"]:
-      best = {"epoch": epoch, "validation": float(np.mean(residuals ** 2)), "train": train_loss,
-              "residuals": residuals}
+    if np.mean(residuals**2) < best["validation"]:
+      best = {
+        "epoch": epoch,
+        "validation": float(np.mean(residuals**2)),
+        "train": train_loss,
+        "residuals": residuals,
+      }
   best["action_variance"] = validation_actions.var(0)
   return best
 
@@ -97,22 +107,28 @@ def main() -> None:
     print_split_statistics(dataset)
     result = probe(dataset, len(slices), slice(None), args.seed)
     mse = np.mean(result["residuals"] ** 2, axis=0)
-    print(f"{robot} ({args.samples} samples), every module's poses to all actions: best epoch "
-          f"{result['epoch']}, action MSE train {result['train']:.4f}, "
-          f"validation {result['validation']:.4f}")
+    print(
+      f"{robot} ({args.samples} samples), every module's poses to all actions: best epoch "
+      f"{result['epoch']}, action MSE train {result['train']:.4f}, "
+      f"validation {result['validation']:.4f}"
+    )
     print(f"  validation MSE per action      {mse}")
     print(f"  fraction of variance left      {mse / result['action_variance']}")
     for module, actions in enumerate(slices, start=1):
       variances, directions = np.linalg.eigh(np.cov(result["residuals"][:, actions].T))
-      print(f"  module {module}: residual variance {variances[-1]:.4f} along "
-            f"{directions[:, -1] * np.sign(directions[0, -1])}, "
-            f"{variances[:-1].sum():.4f} in the other directions")
+      print(
+        f"  module {module}: residual variance {variances[-1]:.4f} along "
+        f"{directions[:, -1] * np.sign(directions[0, -1])}, "
+        f"{variances[:-1].sum():.4f} in the other directions"
+      )
     for module, actions in enumerate(slices, start=1):
       column = probe(dataset, module, actions, args.seed)
       left = np.mean(column["residuals"] ** 2, axis=0) / column["action_variance"]
-      print(f"  modules 1..{module}'s poses to module {module}'s actions (SMPL's column "
-            f"{module}): best epoch {column['epoch']}, action MSE train {column['train']:.4f}, "
-            f"validation {column['validation']:.4f}, fraction of variance left {left}")
+      print(
+        f"  modules 1..{module}'s poses to module {module}'s actions (SMPL's column "
+        f"{module}): best epoch {column['epoch']}, action MSE train {column['train']:.4f}, "
+        f"validation {column['validation']:.4f}, fraction of variance left {left}"
+      )
 
 
 if __name__ == "__main__":

@@ -16,6 +16,7 @@ import dataclasses
 
 import torch
 
+from smpl import training
 from softbench import agents
 from softbench import profiles
 from softbench import robots
@@ -23,7 +24,6 @@ from softbench import run
 from softbench.agents import hyperparameters
 from softbench.agents import learned
 from softbench.tuning import study
-from smpl import training
 
 
 def main() -> None:
@@ -53,27 +53,43 @@ def main() -> None:
 
   def keep(report: training.EpochReport) -> None:
     epoch = report.epoch + 1  # Epochs trained so far.
-    print(f"epoch {epoch}: training loss {report.train_loss:.4f}, "
-          f"validation {report.validation_loss:.4f}", flush=True)
+    print(
+      f"epoch {epoch}: training loss {report.train_loss:.4f}, "
+      f"validation {report.validation_loss:.4f}",
+      flush=True,
+    )
     if epoch in args.keep:
       kept[f"after epoch {epoch}"] = copy.deepcopy(inverse.state_dict())
 
-  result = training.train_inverse_model(inverse, forwards[0], windows[0].train,
-                                        windows[0].validation, config,
-                                        training.default_device(), keep, restart_diverged=True)
+  result = training.train_inverse_model(
+    inverse,
+    forwards[0],
+    windows[0].train,
+    windows[0].validation,
+    config,
+    training.default_device(),
+    keep,
+    restart_diverged=True,
+  )
   best = f"best validation (epoch {result.best_epoch + 1}, what early stopping keeps)"
   kept = {best: copy.deepcopy(inverse.state_dict()), **kept}
   settings = run.settings(args.task, args.agent, args.robot, seeds=1, profile=args.profile)
   for label, state in kept.items():
     inverse.load_state_dict(state)
     inverse.eval()
-    agent = learned.LearnedAgent(arm, args.seed, inverse, [learned.Controller(
-        view, forwards[0].eval(), windows[0].normalisation)])
+    agent = learned.LearnedAgent(
+      arm,
+      args.seed,
+      inverse,
+      [learned.Controller(view, forwards[0].eval(), windows[0].normalisation)],
+    )
     entry, _ = run.evaluate(agent, arm, settings, args.seed)
     position = entry["position_mm"]
-    print(f"{args.agent} {args.robot} {args.task} seed {args.seed}, {label}: position error "
-          f"{position['mean']:.2f} mm (per module {[round(x, 2) for x in position['per_module']]})",
-          flush=True)
+    print(
+      f"{args.agent} {args.robot} {args.task} seed {args.seed}, {label}: position error "
+      f"{position['mean']:.2f} mm (per module {[round(x, 2) for x in position['per_module']]})",
+      flush=True,
+    )
 
 
 if __name__ == "__main__":

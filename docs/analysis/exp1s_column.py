@@ -20,6 +20,9 @@ import dataclasses
 
 import torch
 
+from smpl import progressive
+from smpl import protocol as smpl_protocol
+from smpl import windows as smpl_windows
 from softbench import continual
 from softbench import data
 from softbench import evaluation
@@ -27,9 +30,6 @@ from softbench import profiles
 from softbench import protocols
 from softbench import suite
 from softbench.agents import learned
-from smpl import progressive
-from smpl import protocol as smpl_protocol
-from smpl import windows as smpl_windows
 
 
 def _setting(text: str) -> tuple[str, float]:
@@ -43,8 +43,13 @@ def main() -> None:
   parser.add_argument("--seed", type=int, default=0)
   parser.add_argument("--profile", default="paper")
   parser.add_argument("--epochs", type=int, default=12)
-  parser.add_argument("--settings", type=_setting, nargs="+", default=[("tuned", 0.0)],
-                      help="LEARNING_RATE:POSE_LOSS_WEIGHT entries ('tuned' learning rate)")
+  parser.add_argument(
+    "--settings",
+    type=_setting,
+    nargs="+",
+    default=[("tuned", 0.0)],
+    help="LEARNING_RATE:POSE_LOSS_WEIGHT entries ('tuned' learning rate)",
+  )
   parser.add_argument("--tasks", nargs="*", default=["spiral"])
   args = parser.parse_args()
 
@@ -52,8 +57,9 @@ def main() -> None:
   column_views = protocols.get(continual.PROTOCOL).column_views()
   if not 1 <= stage < len(column_views):
     raise SystemExit(f"--configuration must be 2 to {len(column_views)}")
-  path = learned.checkpoint_file(continual._config(args.seed, profile,
-                                                   [arm for arm, _ in column_views]))
+  path = learned.checkpoint_file(
+    continual._config(args.seed, profile, [arm for arm, _ in column_views])
+  )
   if not path.exists():
     raise SystemExit(f"no cached Exp1S network {path}; run softbench run --protocol exp1s first")
   model = continual.build(args.seed, profile)
@@ -69,33 +75,46 @@ def main() -> None:
     network = progressive.ProgressiveLSTM()
     for controller in model.controllers[:stage]:
       earlier = controller.view
-      network.add_column(smpl_windows.inverse_input_size(earlier.pose_size, earlier.action_size),
-                         earlier.action_size)
+      network.add_column(
+        smpl_windows.inverse_input_size(earlier.pose_size, earlier.action_size), earlier.action_size
+      )
     network.load_state_dict({name: trained[name] for name in network.state_dict()})
     config = dataclasses.replace(
-        tuned, max_epochs=args.epochs, patience=args.epochs + 1,
-        learning_rate=tuned.learning_rate if learning_rate == "tuned" else float(learning_rate),
-        pose_loss_weight=pose_loss_weight)
+      tuned,
+      max_epochs=args.epochs,
+      patience=args.epochs + 1,
+      learning_rate=tuned.learning_rate if learning_rate == "tuned" else float(learning_rate),
+      pose_loss_weight=pose_loss_weight,
+    )
     label = f"learning rate {config.learning_rate:.3g}, pose-loss weight {pose_loss_weight:g}"
-    report = lambda epoch: print(f"{label}: epoch {epoch.epoch + 1}: training loss "
-                                 f"{epoch.train_loss:.4f}, validation {epoch.validation_loss:.4f}",
-                                 flush=True)
+    report = lambda epoch: print(
+      f"{label}: epoch {epoch.epoch + 1}: training loss "
+      f"{epoch.train_loss:.4f}, validation {epoch.validation_loss:.4f}",
+      flush=True,
+    )
     result = smpl_protocol.train_next_column(network, task, config, torch.device("cpu"), report)
     network.requires_grad_(False).eval()
     score = smpl_protocol.evaluate_column(network, stage, task.test, forward)
-    print(f"{label}: best validation {result.best_validation_loss:.4f} at epoch "
-          f"{result.best_epoch + 1}; test action MSE {score.action_mse:.4f}, pose MSE "
-          f"{score.pose_mse:.4f}", flush=True)
+    print(
+      f"{label}: best validation {result.best_validation_loss:.4f} at epoch "
+      f"{result.best_epoch + 1}; test action MSE {score.action_mse:.4f}, pose MSE "
+      f"{score.pose_mse:.4f}",
+      flush=True,
+    )
     retrained = dataclasses.replace(model, network=network)
     agent = retrained.agent(args.configuration, args.seed)
     for name in args.tasks:
-      env = suite.load(arm, name, seed=args.seed,
-                       **suite.length_options(name, profile.episode_length))
+      env = suite.load(
+        arm, name, seed=args.seed, **suite.length_options(name, profile.episode_length)
+      )
       episode = evaluation.run_episode(env, agent, name)
       score = continual._end_effector_scores(episode, arm.length)
-      print(f"{label}: {arm.name} {name}, closed loop in physics: end effector "
-            f"{score['position_mm']:.2f} mm, {score['orientation_deg']:.2f} deg, "
-            f"{score['normalised_tip_percent']:.2f} %", flush=True)
+      print(
+        f"{label}: {arm.name} {name}, closed loop in physics: end effector "
+        f"{score['position_mm']:.2f} mm, {score['orientation_deg']:.2f} deg, "
+        f"{score['normalised_tip_percent']:.2f} %",
+        flush=True,
+      )
 
 
 if __name__ == "__main__":

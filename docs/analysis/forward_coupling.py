@@ -45,13 +45,18 @@ def main() -> None:
   for name in args.robots:
     robot, dataset = robots.make(name), data.load(name, profile.samples, learned.DATA_SEED)
     for module in range(1, robot.num_modules + 1):
-      losses = [protocols.prepare_column(robot, view, dataset, config,
-                                         torch.device("cpu")).forward_training.best_validation_loss
-                for view in (data.View.module(robot, module),
-                             with_distal_actuation(robot, module))]
-      print(f"{name} module {module}: forward model's validation pose MSE from modules "
-            f"1..{module}'s actuation {losses[0]:.5f}, from every module's {losses[1]:.5f} "
-            f"(ratio {losses[0] / losses[1]:.2f})", flush=True)
+      losses = [
+        protocols.prepare_column(
+          robot, view, dataset, config, torch.device("cpu")
+        ).forward_training.best_validation_loss
+        for view in (data.View.module(robot, module), with_distal_actuation(robot, module))
+      ]
+      print(
+        f"{name} module {module}: forward model's validation pose MSE from modules "
+        f"1..{module}'s actuation {losses[0]:.5f}, from every module's {losses[1]:.5f} "
+        f"(ratio {losses[0] / losses[1]:.2f})",
+        flush=True,
+      )
 
 
 if __name__ == "__main__":

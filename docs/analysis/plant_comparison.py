@@ -24,8 +24,9 @@ from softbench.leaderboard import ranking
 METRIC = "position_mm"
 
 
-def estimates(board: ranking.Leaderboard, profile: str, eval_mode: str
-              ) -> dict[tuple[str, str, str], ranking.Estimate]:
+def estimates(
+  board: ranking.Leaderboard, profile: str, eval_mode: str
+) -> dict[tuple[str, str, str], ranking.Estimate]:
   """Position error by (robot, task, agent), plain tasks only, newest record of each setting."""
   found = {}
   for group in board.groups:
@@ -45,27 +46,41 @@ def main() -> None:
   parser.add_argument("--results", type=pathlib.Path, default=leaderboard.DEFAULT_RESULTS)
   args = parser.parse_args()
   found = estimates(leaderboard.build(args.results), args.profile, args.eval)
-  tasks = [task for task in suite.TASKS
-           if any((robot, task, agent) in found for robot in args.robots for agent in agents.AGENTS)]
+  tasks = [
+    task
+    for task in suite.TASKS
+    if any((robot, task, agent) in found for robot in args.robots for agent in agents.AGENTS)
+  ]
   first, second = args.robots
-  print(f"position error (mm), {args.profile} profile, eval {args.eval}, mean ± std over seeds: "
-        f"{first} -> {second}\n")
+  print(
+    f"position error (mm), {args.profile} profile, eval {args.eval}, mean ± std over seeds: "
+    f"{first} -> {second}\n"
+  )
   print("| agent | " + " | ".join(tasks) + " |")
   print("|---" * (len(tasks) + 1) + "|")
   for agent in agents.AGENTS:
-    cells = [" -> ".join(ranking.mean_and_std(found[robot, task, agent])
-                         if (robot, task, agent) in found else "-" for robot in args.robots)
-             for task in tasks]
+    cells = [
+      " -> ".join(
+        ranking.mean_and_std(found[robot, task, agent]) if (robot, task, agent) in found else "-"
+        for robot in args.robots
+      )
+      for task in tasks
+    ]
     if any(cell != "- -> -" for cell in cells):
       print(f"| {agent} | " + " | ".join(cells) + " |")
   learned = [agent for agent in agents.AGENTS if agents.describe(agent).learned]
   print()
   for task in tasks:
     for robot in args.robots:
-      ranked = sorted((found[robot, task, agent].mean, agent) for agent in learned
-                      if (robot, task, agent) in found)
-      print(f"{task} on {robot}, learned agents from best: "
-            + ", ".join(f"{agent} {mean:.2f}" for mean, agent in ranked))
+      ranked = sorted(
+        (found[robot, task, agent].mean, agent)
+        for agent in learned
+        if (robot, task, agent) in found
+      )
+      print(
+        f"{task} on {robot}, learned agents from best: "
+        + ", ".join(f"{agent} {mean:.2f}" for mean, agent in ranked)
+      )
 
 
 if __name__ == "__main__":

@@ -12,18 +12,19 @@ Usage:
 
 import argparse
 
+from smpl import training
 from softbench import agents
 from softbench import profiles
 from softbench import robots
 from softbench.agents import learned
 from softbench.tuning import study
-from smpl import training
 
 
 def main() -> None:
   parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-  parser.add_argument("--agents", nargs="+", default=["vae-lstm", "lstm", "mlp"],
-                      help="centralised learned agents")
+  parser.add_argument(
+    "--agents", nargs="+", default=["vae-lstm", "lstm", "mlp"], help="centralised learned agents"
+  )
   parser.add_argument("--robot", default="pneumatic-433")
   parser.add_argument("--profile", default="paper")
   parser.add_argument("--seeds", type=int, default=5)
@@ -44,8 +45,9 @@ def main() -> None:
 
       validation = training.evaluate_loss(agent.inverse, loss, windows.validation)
       test = training.evaluate_loss(agent.inverse, loss, windows.test)
-      print(f"{name} seed {seed}: validation loss {validation:.4f}, test loss {test:.4f}",
-            flush=True)
+      print(
+        f"{name} seed {seed}: validation loss {validation:.4f}, test loss {test:.4f}", flush=True
+      )
 
 
 if __name__ == "__main__":

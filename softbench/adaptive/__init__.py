@@ -14,7 +14,6 @@ Every learned agent can take part: inactive modules get zero actuation (``Learne
 computes every output, masked the same way.
 """
 
-
 from softbench import agents
 from softbench import profiles
 from softbench import progress as progress_bars
@@ -27,9 +26,16 @@ from softbench.suite import reach
 DEFAULT_TARGETS = 20  # Virtual targets of ``softbench run --adaptive``.
 
 
-def run(robot: str, agent: str, profile: profiles.Profile, targets: int = DEFAULT_TARGETS,
-        module: int | None = None, eval_mode: str = "physics",
-        helpers: str = experiment.DEFAULT_HELPERS, show_progress: bool = False) -> dict:
+def run(
+  robot: str,
+  agent: str,
+  profile: profiles.Profile,
+  targets: int = DEFAULT_TARGETS,
+  module: int | None = None,
+  eval_mode: str = "physics",
+  helpers: str = experiment.DEFAULT_HELPERS,
+  show_progress: bool = False,
+) -> dict:
   """Builds (trains or loads) ``agent`` with ``experiment.AGENT_SEED``, reaches ``targets``
   targets adaptively, and returns the record's ``adaptive`` section (``report.section``).
 
@@ -41,20 +47,32 @@ def run(robot: str, agent: str, profile: profiles.Profile, targets: int = DEFAUL
   module = reach.check_module(arm, module)
   experiment.check_helpers(helpers)
   if agents.learner(agent) is None:
-    raise ValueError(f"--adaptive needs an agent trained on babbling "
-                     f"({', '.join(agents.babbling_learners())}), got {agent!r}")
+    raise ValueError(
+      f"--adaptive needs an agent trained on babbling "
+      f"({', '.join(agents.babbling_learners())}), got {agent!r}"
+    )
   learner = experiment.check_agent(
-      agents.make(agent, arm, experiment.AGENT_SEED, profile, show_progress))
+    agents.make(agent, arm, experiment.AGENT_SEED, profile, show_progress)
+  )
   learner.error_source = eval_mode
   stages = experiment.timing(arm, profile)
   threshold = experiment.threshold_mm(arm, module)
   progress = progress_bars.counting(show_progress, transient=True)
   with progress:
     bar = progress.add_task(f"adaptive {agent} on {robot}: targets", total=targets)
-    outcomes = experiment.reach_targets(learner, arm, targets, module, stages, threshold,
-                                        helpers, on_target=lambda: progress.advance(bar))
-  return report.section(outcomes, arm.num_modules, module, threshold, stages,
-                        arm.control_timestep, helpers)
+    outcomes = experiment.reach_targets(
+      learner,
+      arm,
+      targets,
+      module,
+      stages,
+      threshold,
+      helpers,
+      on_target=lambda: progress.advance(bar),
+    )
+  return report.section(
+    outcomes, arm.num_modules, module, threshold, stages, arm.control_timestep, helpers
+  )
 
 
 __all__ = ["DEFAULT_TARGETS", "experiment", "procedure", "report", "run"]

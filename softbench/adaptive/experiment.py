@@ -118,13 +118,20 @@ def _settled_error_mm(tips: np.ndarray, target: np.ndarray, steps: int) -> float
   return float(np.mean(metrics.position_error_mm(tips[-steps:], target)))
 
 
-def reach_target(agent: learned.LearnedAgent, robot: robot_base.SoftArm, target_seed: int,
-                 module: int, stages: Timing, threshold: float) -> TargetOutcome:
+def reach_target(
+  agent: learned.LearnedAgent,
+  robot: robot_base.SoftArm,
+  target_seed: int,
+  module: int,
+  stages: Timing,
+  threshold: float,
+) -> TargetOutcome:
   """Runs the staged procedure on the target of ``target_seed`` (module docstring), then the
   all-on comparison, with ``threshold`` in mm and the agent's own ``helper_targets``."""
   staged = procedure.ActivationProcedure(robot.num_modules, module, threshold)
-  env = suite.load(robot, "reach", seed=target_seed, module=module,
-                   steps=staged.max_stages * stages.stage_steps)
+  env = suite.load(
+    robot, "reach", seed=target_seed, module=module, steps=staged.max_stages * stages.stage_steps
+  )
   time_step = env.reset()
   target = np.array(time_step.observation["target"][0], dtype=float)
   agent.reset(agents.EpisodeInfo("reach", env.task.scored_modules()))
@@ -141,19 +148,25 @@ def reach_target(agent: learned.LearnedAgent, robot: robot_base.SoftArm, target_
   finally:
     agent.active_modules = None
   all_on = evaluation.run_episode(
-      suite.load(robot, "reach", seed=target_seed, module=module, steps=len(actions)),
-      agent, "reach")
+    suite.load(robot, "reach", seed=target_seed, module=module, steps=len(actions)), agent, "reach"
+  )
   all_on_tips = all_on.poses[:, module - 1, :3]
   actions, holding = np.array(actions), slice(-stages.scored_steps, None)
   return TargetOutcome(
-      target_seed=target_seed, target_mm=target * metrics.MM_PER_M, stages=staged.results,
-      stage_ends=tuple(stage_ends), final_active=staged.active,
-      final_error_mm=staged.final_error,
-      all_on_error_mm=_settled_error_mm(all_on_tips, target, stages.scored_steps),
-      effort=_effort(actions), all_on_effort=_effort(all_on.actions),
-      holding_effort=_effort(actions[holding]) / stages.scored_steps,
-      all_on_holding_effort=_effort(all_on.actions[holding]) / stages.scored_steps,
-      path_mm=np.array(tips) * metrics.MM_PER_M, all_on_path_mm=all_on_tips * metrics.MM_PER_M)
+    target_seed=target_seed,
+    target_mm=target * metrics.MM_PER_M,
+    stages=staged.results,
+    stage_ends=tuple(stage_ends),
+    final_active=staged.active,
+    final_error_mm=staged.final_error,
+    all_on_error_mm=_settled_error_mm(all_on_tips, target, stages.scored_steps),
+    effort=_effort(actions),
+    all_on_effort=_effort(all_on.actions),
+    holding_effort=_effort(actions[holding]) / stages.scored_steps,
+    all_on_holding_effort=_effort(all_on.actions[holding]) / stages.scored_steps,
+    path_mm=np.array(tips) * metrics.MM_PER_M,
+    all_on_path_mm=all_on_tips * metrics.MM_PER_M,
+  )
 
 
 def check_agent(agent: agents.Agent) -> learned.LearnedAgent:
@@ -163,9 +176,16 @@ def check_agent(agent: agents.Agent) -> learned.LearnedAgent:
   return agent
 
 
-def reach_targets(agent: agents.Agent, robot: robot_base.SoftArm, targets: int,
-                  module: int | None, stages: Timing, threshold: float | None = None,
-                  helpers: str = DEFAULT_HELPERS, on_target=None) -> list[TargetOutcome]:
+def reach_targets(
+  agent: agents.Agent,
+  robot: robot_base.SoftArm,
+  targets: int,
+  module: int | None,
+  stages: Timing,
+  threshold: float | None = None,
+  helpers: str = DEFAULT_HELPERS,
+  on_target=None,
+) -> list[TargetOutcome]:
   """``reach_target`` for the targets of seeds 0 .. ``targets`` - 1; ``threshold`` in mm
   (default ``threshold_mm``); ``on_target()`` is called after each (a progress bar).
 
@@ -190,5 +210,6 @@ def reach_targets(agent: agents.Agent, robot: robot_base.SoftArm, targets: int,
 
 def check_helpers(helpers: str) -> None:
   if helpers not in learned.HELPER_TARGETS:
-    raise ValueError(f"unknown helpers {helpers!r}; choose one of "
-                     f"{', '.join(learned.HELPER_TARGETS)}")
+    raise ValueError(
+      f"unknown helpers {helpers!r}; choose one of {', '.join(learned.HELPER_TARGETS)}"
+    )

@@ -57,8 +57,11 @@ def candidates(num_modules: int, target_module: int) -> tuple[int, ...]:
   """The modules to try after the target module: outwards from it, the preceding one first."""
   order = []
   for distance in range(1, num_modules):
-    order += [module for module in (target_module - distance, target_module + distance)
-              if 1 <= module <= num_modules]
+    order += [
+      module
+      for module in (target_module - distance, target_module + distance)
+      if 1 <= module <= num_modules
+    ]
   return tuple(order)
 
 
@@ -73,8 +76,11 @@ class ActivationProcedure:
   def __init__(self, num_modules: int, target_module: int, threshold: float):
     if isinstance(num_modules, bool) or not isinstance(num_modules, int) or num_modules < 1:
       raise ValueError(f"num_modules must be a positive integer, got {num_modules!r}")
-    if (isinstance(target_module, bool) or not isinstance(target_module, int)
-        or not 1 <= target_module <= num_modules):
+    if (
+      isinstance(target_module, bool)
+      or not isinstance(target_module, int)
+      or not 1 <= target_module <= num_modules
+    ):
       raise ValueError(f"target module must be 1 to {num_modules}, got {target_module!r}")
     if not _non_negative(threshold):
       raise ValueError(f"threshold must be a non-negative number, got {threshold!r}")
@@ -96,8 +102,10 @@ class ActivationProcedure:
   def labels(self) -> tuple[str, ...]:
     """Every stage label this procedure can produce, in the order stages happen."""
     tried = [self._trial(module) for module in candidates(self.num_modules, self.target_module)]
-    return tuple(stage.label for stage in
-                 [Stage(TARGET, (self.target_module,)), *tried, Stage(REVERT, self._kept)])
+    return tuple(
+      stage.label
+      for stage in [Stage(TARGET, (self.target_module,)), *tried, Stage(REVERT, self._kept)]
+    )
 
   @property
   def active(self) -> tuple[int, ...]:
@@ -159,5 +167,9 @@ class ActivationProcedure:
 
 
 def _non_negative(value) -> bool:
-  return (isinstance(value, numbers.Real) and not isinstance(value, bool)
-          and math.isfinite(value) and value >= 0)
+  return (
+    isinstance(value, numbers.Real)
+    and not isinstance(value, bool)
+    and math.isfinite(value)
+    and value >= 0
+  )

@@ -15,11 +15,16 @@ from softbench import profiles
 from softbench import robots
 from softbench.agents.base import Agent
 from softbench.agents.base import EpisodeInfo
-from softbench.agents.learners import OPTIMISATION, RECURRENT, Choice, Learner, LogUniform
+from softbench.agents.learners import OPTIMISATION
+from softbench.agents.learners import RECURRENT
+from softbench.agents.learners import Choice
+from softbench.agents.learners import Learner
+from softbench.agents.learners import LogUniform
 from softbench.data import seeding
 
-AgentEntry = collections.namedtuple("AgentEntry", ["module", "learned", "description", "learner"],
-                                    defaults=[None])
+AgentEntry = collections.namedtuple(
+  "AgentEntry", ["module", "learned", "description", "learner"], defaults=[None]
+)
 """An agent: the module whose ``build`` makes it (None for a babbling learner, which
 ``agents.learned`` trains), whether it learns, a one-line description and its ``Learner`` (None:
 not trained on babbling)."""
@@ -30,28 +35,54 @@ def _babbling_learner(description: str, learner: Learner) -> AgentEntry:
 
 
 _AGENTS = {
-    # SMPL's width and depth stay at the paper's 2 LSTM layers of 32 units per column (SPEC 5):
-    # only its optimisation is tuned.
-    "smpl": _babbling_learner("SMPL: progressive LSTM columns, one per module",
-                              Learner(per_module=True, search_space=OPTIMISATION)),
-    "mlp": _babbling_learner("MLP baseline (3 layers)", Learner(
-        False, "smpl.baselines:MLPInverse",
-        {**OPTIMISATION, "hidden_size": Choice((32, 64, 128, 256))})),
-    "lstm": _babbling_learner("LSTM baseline", Learner(
-        False, "smpl.baselines:LSTMInverse", {**OPTIMISATION, **RECURRENT})),
-    "vae-lstm": _babbling_learner("variational LSTM baseline", Learner(
-        False, "smpl.baselines:VAELSTMInverse",
-        {**OPTIMISATION, **RECURRENT, "latent_size": Choice((2, 4, 8, 16)),
-         "kl_weight": LogUniform(1e-5, 1e-1)})),
-    "bilstm": _babbling_learner("bidirectional LSTM baseline", Learner(
-        False, "smpl.baselines:BiLSTMInverse", {**OPTIMISATION, **RECURRENT})),
-    "sac": AgentEntry("softbench.agents.sac", True,
-                      "SAC (Stable-Baselines3): model-free RL, learns by acting on the arm"),
-    "zero": AgentEntry("softbench.agents.zero", False, "always the zero action (sanity check)"),
-    "random": AgentEntry("softbench.agents.random_actions", False,
-                         "uniform random actions (sanity check)"),
-    "reference": AgentEntry("softbench.agents.reference", False,
-                            "model-based: uses the simulator itself (what the physics allows)"),
+  # SMPL's width and depth stay at the paper's 2 LSTM layers of 32 units per column (SPEC 5):
+  # only its optimisation is tuned.
+  "smpl": _babbling_learner(
+    "SMPL: progressive LSTM columns, one per module",
+    Learner(per_module=True, search_space=OPTIMISATION),
+  ),
+  "mlp": _babbling_learner(
+    "MLP baseline (3 layers)",
+    Learner(
+      False,
+      "smpl.baselines:MLPInverse",
+      {**OPTIMISATION, "hidden_size": Choice((32, 64, 128, 256))},
+    ),
+  ),
+  "lstm": _babbling_learner(
+    "LSTM baseline", Learner(False, "smpl.baselines:LSTMInverse", {**OPTIMISATION, **RECURRENT})
+  ),
+  "vae-lstm": _babbling_learner(
+    "variational LSTM baseline",
+    Learner(
+      False,
+      "smpl.baselines:VAELSTMInverse",
+      {
+        **OPTIMISATION,
+        **RECURRENT,
+        "latent_size": Choice((2, 4, 8, 16)),
+        "kl_weight": LogUniform(1e-5, 1e-1),
+      },
+    ),
+  ),
+  "bilstm": _babbling_learner(
+    "bidirectional LSTM baseline",
+    Learner(False, "smpl.baselines:BiLSTMInverse", {**OPTIMISATION, **RECURRENT}),
+  ),
+  "sac": AgentEntry(
+    "softbench.agents.sac",
+    True,
+    "SAC (Stable-Baselines3): model-free RL, learns by acting on the arm",
+  ),
+  "zero": AgentEntry("softbench.agents.zero", False, "always the zero action (sanity check)"),
+  "random": AgentEntry(
+    "softbench.agents.random_actions", False, "uniform random actions (sanity check)"
+  ),
+  "reference": AgentEntry(
+    "softbench.agents.reference",
+    False,
+    "model-based: uses the simulator itself (what the physics allows)",
+  ),
 }
 AGENTS = tuple(_AGENTS)
 
@@ -79,9 +110,13 @@ def describe(name: str) -> AgentEntry:
   return _AGENTS[name]
 
 
-def make(name: str, robot: str | robots.SoftArm, seed: int = 0,
-         profile: str | profiles.Profile = profiles.DEFAULT_PROFILE,
-         show_progress: bool = False) -> Agent:
+def make(
+  name: str,
+  robot: str | robots.SoftArm,
+  seed: int = 0,
+  profile: str | profiles.Profile = profiles.DEFAULT_PROFILE,
+  show_progress: bool = False,
+) -> Agent:
   """Agent ``name`` for ``robot``, built (and trained, if it learns) with ``seed`` and
   ``profile``; ``show_progress`` shows training progress bars.
 
@@ -94,8 +129,9 @@ def make(name: str, robot: str | robots.SoftArm, seed: int = 0,
   seeding.check_seed(seed)
   if entry.learner is not None:
     learned = importlib.import_module("softbench.agents.learned")
-    return learned.build_agent(name, arm, seed, profile, entry.learner.per_module,
-                               entry.learner.make_model, show_progress)
+    return learned.build_agent(
+      name, arm, seed, profile, entry.learner.per_module, entry.learner.make_model, show_progress
+    )
   build: Callable[..., Agent] = importlib.import_module(entry.module).build
   return build(arm, seed, profile, show_progress)
 
@@ -106,13 +142,15 @@ def learner(name: str) -> Learner | None:
   return describe(name).learner
 
 
-def training_summary(name: str, robot: robots.SoftArm, seed: int,
-                     profile: profiles.Profile) -> dict | None:
+def training_summary(
+  name: str, robot: robots.SoftArm, seed: int, profile: profiles.Profile
+) -> dict | None:
   """What an agent that learns by acting spent on ``seed``'s training (environment steps,
   episodes, wall time), read from its cache; None for the other agents."""
   module = describe(name).module
-  summary = None if module is None else getattr(importlib.import_module(module),
-                                                "training_summary", None)
+  summary = (
+    None if module is None else getattr(importlib.import_module(module), "training_summary", None)
+  )
   return None if summary is None else summary(robot, seed, profile)
 
 
@@ -122,5 +160,16 @@ def babbling_learners() -> tuple[str, ...]:
   return tuple(name for name in AGENTS if learner(name) is not None)
 
 
-__all__ = ["AGENTS", "Agent", "AgentEntry", "EpisodeInfo", "Learner", "babbling_learners",
-           "describe", "learner", "make", "register", "training_summary"]
+__all__ = [
+  "AGENTS",
+  "Agent",
+  "AgentEntry",
+  "EpisodeInfo",
+  "Learner",
+  "babbling_learners",
+  "describe",
+  "learner",
+  "make",
+  "register",
+  "training_summary",
+]

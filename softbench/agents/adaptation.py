@@ -68,8 +68,10 @@ class RetrainedConfig:
   def key(self) -> str:
     text = repr(dataclasses.astuple(self)).encode()
     faults = "-".join(f"{module}.{actuator}.{gain:g}" for module, actuator, gain in self.faults)
-    return (f"{self.healthy_checkpoint.split('-seed')[0]}-fault{faults}-column{self.column}-"
-            f"seed{self.seed}-{hashlib.sha256(text).hexdigest()[:12]}")
+    return (
+      f"{self.healthy_checkpoint.split('-seed')[0]}-fault{faults}-column{self.column}-"
+      f"seed{self.seed}-{hashlib.sha256(text).hexdigest()[:12]}"
+    )
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -96,8 +98,10 @@ def faulty_module(robot: robot_base.SoftArm) -> int:
   """The one module that holds every fault of ``robot``; a one-line ValueError otherwise."""
   modules = sorted({fault.module for fault in robot.faults})
   if len(modules) != 1:
-    raise ValueError("retraining one column needs faults in exactly one module, got "
-                     + (f"modules {', '.join(map(str, modules))}" if modules else "no fault"))
+    raise ValueError(
+      "retraining one column needs faults in exactly one module, got "
+      + (f"modules {', '.join(map(str, modules))}" if modules else "no fault")
+    )
   return modules[0]
 
 
@@ -110,12 +114,17 @@ def read_wall_time(path: pathlib.Path) -> float | None:
 
 
 def write_wall_time(path: pathlib.Path, seconds: float) -> None:
-  storage.write_atomically(path.with_name(path.name + TIMING_SUFFIX),
-                           json.dumps({"wall_time_s": seconds}) + "\n")
+  storage.write_atomically(
+    path.with_name(path.name + TIMING_SUFFIX), json.dumps({"wall_time_s": seconds}) + "\n"
+  )
 
 
-def retrain_column(agent: learned.LearnedAgent, faulty_robot: robot_base.SoftArm,
-                   profile: profiles.Profile, show_progress: bool = False) -> RetrainedColumn:
+def retrain_column(
+  agent: learned.LearnedAgent,
+  faulty_robot: robot_base.SoftArm,
+  profile: profiles.Profile,
+  show_progress: bool = False,
+) -> RetrainedColumn:
   """``agent`` (the smpl agent built for the healthy robot with ``profile``) with the faulty
   module's column retrained, from the cache or trained now and then cached (module docstring);
   the retraining is seeded by the agent's seed.
@@ -130,23 +139,38 @@ def retrain_column(agent: learned.LearnedAgent, faulty_robot: robot_base.SoftArm
   forward_modules = tuple(range(module, faulty_robot.num_modules + 1))
   healthy = faulty_robot.without_faults()
   config = RetrainedConfig(
-      learned.checkpoint_path("smpl", healthy, seed, profile, per_module=True).stem,
-      tuple(sorted((f.module, f.actuator, f.gain) for f in faulty_robot.faults)),
-      hashlib.sha256(faulty_robot.to_xml().encode()).hexdigest(), module, forward_modules,
-      profile.samples, seed, profile.max_epochs, profile.patience, profile.compile)
+    learned.checkpoint_path("smpl", healthy, seed, profile, per_module=True).stem,
+    tuple(sorted((f.module, f.actuator, f.gain) for f in faulty_robot.faults)),
+    hashlib.sha256(faulty_robot.to_xml().encode()).hexdigest(),
+    module,
+    forward_modules,
+    profile.samples,
+    seed,
+    profile.max_epochs,
+    profile.patience,
+    profile.compile,
+  )
   path = learned.checkpoint_file(config)
   inverse = copy.deepcopy(agent.inverse)
   forwards = [copy.deepcopy(controller.forward).freeze() for controller in agent.controllers]
-  bundle = torch.nn.ModuleDict({"inverse": inverse,
-                                "forward_models": torch.nn.ModuleList(forwards)})
+  bundle = torch.nn.ModuleDict(
+    {"inverse": inverse, "forward_models": torch.nn.ModuleList(forwards)}
+  )
   # A damaged cached file is reported (storage.read_cached) and trained again; a refused file
   # leaves the bundle untouched, so the retraining starts from the healthy weights.
-  trained_now = storage.read_cached(
-      path, lambda found: checkpoint.load_checkpoint(found, bundle, config), "retrained column",
-      "training it again") is None
+  trained_now = (
+    storage.read_cached(
+      path,
+      lambda found: checkpoint.load_checkpoint(found, bundle, config),
+      "retrained column",
+      "training it again",
+    )
+    is None
+  )
   if trained_now:
-    dataset = data.collect(faulty_robot, samples=profile.samples, seed=learned.DATA_SEED,
-                           progress=show_progress)
+    dataset = data.collect(
+      faulty_robot, samples=profile.samples, seed=learned.DATA_SEED, progress=show_progress
+    )
     started = time.perf_counter()
     _retrain(agent, inverse, forwards, dataset, module, seed, profile, show_progress)
     wall_time = round(time.perf_counter() - started, 3)
@@ -155,43 +179,73 @@ def retrain_column(agent: learned.LearnedAgent, faulty_robot: robot_base.SoftArm
   else:
     wall_time = read_wall_time(path)
   inverse.cpu().requires_grad_(False).eval()
-  controllers = [learned.Controller(controller.view, forward.cpu().eval(),
-                                    controller.normalisation)
-                 for controller, forward in zip(agent.controllers, forwards)]
+  controllers = [
+    learned.Controller(controller.view, forward.cpu().eval(), controller.normalisation)
+    for controller, forward in zip(agent.controllers, forwards)
+  ]
   adapted = learned.LearnedAgent(faulty_robot, seed, inverse, controllers, agent.error_source)
   return RetrainedColumn(adapted, module, forward_modules, wall_time, trained_now)
 
 
-def _retrain(agent: learned.LearnedAgent, inverse: progressive.ProgressiveLSTM,
-             forwards: list, dataset: data.Dataset, module: int, seed: int,
-             profile: profiles.Profile, show: bool) -> None:
+def _retrain(
+  agent: learned.LearnedAgent,
+  inverse: progressive.ProgressiveLSTM,
+  forwards: list,
+  dataset: data.Dataset,
+  module: int,
+  seed: int,
+  profile: profiles.Profile,
+  show: bool,
+) -> None:
   """Retrains, in place on ``dataset`` (the faulty robot's babbling), forward models module..N
   and column ``module`` of ``inverse``."""
-  windows = [data.windows(dataset, controller.view, fitted=controller.normalisation)
-             for controller in agent.controllers]
+  windows = [
+    data.windows(dataset, controller.view, fitted=controller.normalisation)
+    for controller in agent.controllers
+  ]
   forward_config, inverse_config = learned.training_configs(
-      seed, profile, hyperparameters.values("smpl", agent.robot.name))
+    seed, profile, hyperparameters.values("smpl", agent.robot.name)
+  )
   device = training.default_device()
   label = f"{dataset.robot_name} seed {seed}"
   for index in range(module - 1, len(forwards)):
     forwards[index].requires_grad_(True)
     bar_label = f"forward module-{index + 1} {label}"
     with learned.progress_bar(bar_label, profile.max_epochs, show) as bar:
-      training.train_forward_model(forwards[index], windows[index].train,
-                                   windows[index].validation, forward_config, device, bar)
+      training.train_forward_model(
+        forwards[index],
+        windows[index].train,
+        windows[index].validation,
+        forward_config,
+        device,
+        bar,
+      )
   inverse.requires_grad_(False)
   inverse.columns[module - 1].requires_grad_(True)
   split = lambda name: smpl_windows.ModuleWindows(tuple(getattr(w, name) for w in windows))
   with learned.progress_bar(f"inverse column {module} {label}", profile.max_epochs, show) as bar:
-    training.train_column_jointly(inverse, forwards, split("train"), split("validation"),
-                                  inverse_config, device, bar, column=module - 1)
+    training.train_column_jointly(
+      inverse,
+      forwards,
+      split("train"),
+      split("validation"),
+      inverse_config,
+      device,
+      bar,
+      column=module - 1,
+    )
   inverse.requires_grad_(False)
 
 
-def columns_bit_identical(before: progressive.ProgressiveLSTM,
-                          after: progressive.ProgressiveLSTM, skip: int) -> bool:
+def columns_bit_identical(
+  before: progressive.ProgressiveLSTM, after: progressive.ProgressiveLSTM, skip: int
+) -> bool:
   """Whether every column but ``skip`` (a module, from 1) has bit-identical parameters."""
   return all(
-      all(torch.equal(tensor, after.columns[index].state_dict()[name].to(tensor.device))
-          for name, tensor in column.state_dict().items())
-      for index, column in enumerate(before.columns) if index != skip - 1)
+    all(
+      torch.equal(tensor, after.columns[index].state_dict()[name].to(tensor.device))
+      for name, tensor in column.state_dict().items()
+    )
+    for index, column in enumerate(before.columns)
+    if index != skip - 1
+  )

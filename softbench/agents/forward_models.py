@@ -49,8 +49,7 @@ class ForwardModelConfig:
   @property
   def key(self) -> str:
     text = repr(dataclasses.astuple(self)).encode()
-    return (f"{self.robot}-{self.view}-seed{self.seed}-"
-            f"{hashlib.sha256(text).hexdigest()[:12]}")
+    return f"{self.robot}-{self.view}-seed{self.seed}-{hashlib.sha256(text).hexdigest()[:12]}"
 
 
 def cache_file(config: ForwardModelConfig) -> pathlib.Path:
@@ -58,39 +57,68 @@ def cache_file(config: ForwardModelConfig) -> pathlib.Path:
   return storage.softbench_home() / FOLDER / f"{config.key}.pt"
 
 
-def configs(robot: robot_base.SoftArm, views: list[data.View], samples: int, data_seed: int,
-            config: training.ForwardTrainingConfig, training_version: int
-            ) -> list[ForwardModelConfig]:
+def configs(
+  robot: robot_base.SoftArm,
+  views: list[data.View],
+  samples: int,
+  data_seed: int,
+  config: training.ForwardTrainingConfig,
+  training_version: int,
+) -> list[ForwardModelConfig]:
   """The cache configs of ``views``' forward models trained with ``config`` (``prepare``)."""
   xml_sha256 = hashlib.sha256(robot.to_xml().encode()).hexdigest()
-  return [ForwardModelConfig(robot.name, xml_sha256, view.name, samples, data_seed, config.seed,
-                             config.max_epochs, config.patience, config.compile, training_version)
-          for view in views]
+  return [
+    ForwardModelConfig(
+      robot.name,
+      xml_sha256,
+      view.name,
+      samples,
+      data_seed,
+      config.seed,
+      config.max_epochs,
+      config.patience,
+      config.compile,
+      training_version,
+    )
+    for view in views
+  ]
 
 
-def prepare(robot: robot_base.SoftArm, views: list[data.View], dataset: data.Dataset,
-            samples: int, data_seed: int, config: training.ForwardTrainingConfig,
-            training_version: int, progress_label: str | None = None
-            ) -> tuple[list[data.SplitWindows], list[smpl_forward.ForwardModel]]:
+def prepare(
+  robot: robot_base.SoftArm,
+  views: list[data.View],
+  dataset: data.Dataset,
+  samples: int,
+  data_seed: int,
+  config: training.ForwardTrainingConfig,
+  training_version: int,
+  progress_label: str | None = None,
+) -> tuple[list[data.SplitWindows], list[smpl_forward.ForwardModel]]:
   """Each view's windows of ``dataset`` (``samples`` babbling samples of seed ``data_seed``) and
   its frozen forward model trained with ``config``: from the cache, or trained now (with an epoch
   progress bar named ``progress_label VIEW`` if given) and cached."""
   windows, forwards = [], []
-  for view, key in zip(views, configs(robot, views, samples, data_seed, config,
-                                      training_version)):
+  for view, key in zip(views, configs(robot, views, samples, data_seed, config, training_version)):
     path = cache_file(key)
     partial = path.with_suffix(".partial")  # Its training snapshots until it is saved.
     zoo.restore(path)
-    cached = storage.read_cached(path, lambda found: _load(found, key, dataset, view),
-                                 "forward model", "training it again")
+    cached = storage.read_cached(
+      path, lambda found: _load(found, key, dataset, view), "forward model", "training it again"
+    )
     if cached:
       split, model = cached
     else:
-      with snapshots.resumable(partial), (
+      with (
+        snapshots.resumable(partial),
+        (
           progress.EpochProgressBar(f"{progress_label} {view.name}", config.max_epochs)
-          if progress_label else contextlib.nullcontext(None)) as bar:
-        column = protocols.prepare_column(robot, view, dataset, config,
-                                          training.default_device(), bar)
+          if progress_label
+          else contextlib.nullcontext(None)
+        ) as bar,
+      ):
+        column = protocols.prepare_column(
+          robot, view, dataset, config, training.default_device(), bar
+        )
       split, model = column.windows, column.forward_model
       checkpoint.save_checkpoint(path, model, key)
       snapshots.discard(partial)
@@ -99,8 +127,9 @@ def prepare(robot: robot_base.SoftArm, views: list[data.View], dataset: data.Dat
   return windows, forwards
 
 
-def _load(path: pathlib.Path, key: ForwardModelConfig, dataset: data.Dataset, view: data.View
-          ) -> tuple[data.SplitWindows, smpl_forward.ForwardModel]:
+def _load(
+  path: pathlib.Path, key: ForwardModelConfig, dataset: data.Dataset, view: data.View
+) -> tuple[data.SplitWindows, smpl_forward.ForwardModel]:
   """The view's windows and the frozen forward model cached at ``path``; raises if the file
   fails its checks."""
   split = data.windows(dataset, view)

@@ -11,15 +11,16 @@ this file:
 An agent on a robot without an entry of its own uses the default robot's values; an agent
 without any trains with its model's and optimiser's defaults (a new baseline needs no entry).
 ``study`` is the summary of the Optuna study that chose the values (null: not chosen by a study).
-``values`` reads the file, ``adopt`` writes a study's choice into it. Parameters named in ``TRAINING_PARAMETERS``
-go to the inverse model's optimiser (``smpl.training.InverseTrainingConfig``), the others to the
-agent's model factory as keyword arguments (``smpl.baselines``). SMPL's width and depth stay at
-the paper's 2 LSTM layers of 32 units per column (SPEC 5): only its optimisation is tuned.
+``values`` reads the file, ``adopt`` writes a study's choice into it. Parameters named in
+``TRAINING_PARAMETERS`` go to the inverse model's optimiser
+(``smpl.training.InverseTrainingConfig``), the others to the agent's model factory as keyword
+arguments (``smpl.baselines``). SMPL's width and depth stay at the paper's 2 LSTM layers of 32
+units per column (SPEC 5): only its optimisation is tuned.
 """
 
+from collections.abc import Mapping
 import json
 import pathlib
-from collections.abc import Mapping
 
 from softbench import agents
 from softbench import robots
@@ -34,8 +35,9 @@ def search_space(agent: str) -> Mapping:
   ``Learner.search_space``)."""
   tuned = {name: agents.learner(name).search_space for name in agents.babbling_learners()}
   if agent not in tuned:
-    raise ValueError(f"agent {agent!r} has no hyperparameters to tune; learned agents: "
-                     f"{', '.join(tuned)}")
+    raise ValueError(
+      f"agent {agent!r} has no hyperparameters to tune; learned agents: {', '.join(tuned)}"
+    )
   return tuned[agent]
 
 
@@ -55,8 +57,9 @@ def check_params(agent: str, params: dict) -> dict:
     raise ValueError(f"{agent}: hyperparameters must be {', '.join(sorted(space))}, got {names}")
   for name, value in params.items():
     if not space[name].contains(value):
-      raise ValueError(f"{agent}: {name} = {value!r} is outside its range "
-                       f"({space[name].describe()})")
+      raise ValueError(
+        f"{agent}: {name} = {value!r} is outside its range ({space[name].describe()})"
+      )
   return params
 
 
@@ -103,8 +106,9 @@ def model_settings(params: dict) -> dict:
   return {name: value for name, value in params.items() if name not in TRAINING_PARAMETERS}
 
 
-def adopt(agent: str, robot: str, params: dict, study: dict,
-          path: pathlib.Path | None = None) -> None:
+def adopt(
+  agent: str, robot: str, params: dict, study: dict, path: pathlib.Path | None = None
+) -> None:
   """Commits ``params`` (chosen by ``study``) as ``agent``'s values on ``robot``, atomically."""
   path = PATH if path is None else path
   table = load(path)

@@ -111,8 +111,14 @@ class LearnedAgent(base.Agent):
   inputs.
   """
 
-  def __init__(self, robot: robot_base.SoftArm, seed: int, inverse: InverseModel,
-               controllers: list[Controller], error_source: str = "physics"):
+  def __init__(
+    self,
+    robot: robot_base.SoftArm,
+    seed: int,
+    inverse: InverseModel,
+    controllers: list[Controller],
+    error_source: str = "physics",
+  ):
     super().__init__(robot, seed)
     self.inverse = inverse
     self.controllers = controllers
@@ -130,8 +136,9 @@ class LearnedAgent(base.Agent):
 
   def reset(self, episode: base.EpisodeInfo) -> None:
     if self.error_source not in ERROR_SOURCES:
-      raise ValueError(f"error_source must be one of {', '.join(ERROR_SOURCES)}, "
-                       f"got {self.error_source!r}")
+      raise ValueError(
+        f"error_source must be one of {', '.join(ERROR_SOURCES)}, got {self.error_source!r}"
+      )
     self._scored = np.array(episode.scored_modules) - 1
     self._reset_memory()
     for controller in self.controllers:
@@ -141,14 +148,15 @@ class LearnedAgent(base.Agent):
   def _full_target(self, target: np.ndarray, poses: np.ndarray) -> np.ndarray:
     """Every module's target pose (module docstring: ``helper_targets``)."""
     if self.helper_targets not in HELPER_TARGETS:
-      raise ValueError(f"helper_targets must be one of {', '.join(HELPER_TARGETS)}, "
-                       f"got {self.helper_targets!r}")
+      raise ValueError(
+        f"helper_targets must be one of {', '.join(HELPER_TARGETS)}, got {self.helper_targets!r}"
+      )
     full = self._start_poses.copy()
     if self.helper_targets == "share" and len(self._scored) == 1:
       full = poses.copy()
       full[self._module_active(), :3] += target[0, :3] - poses[self._scored[0], :3]
       full[self._scored] = self._start_poses[self._scored]
-    full[self._scored, :target.shape[1]] = target
+    full[self._scored, : target.shape[1]] = target
     return full
 
   def act(self, observation: dict) -> np.ndarray:
@@ -159,8 +167,9 @@ class LearnedAgent(base.Agent):
     target = self._full_target(np.asarray(observation["target"], dtype=float), poses)
     action = np.zeros(self.robot.action_dim)
     with torch.no_grad():
-      inputs = [self._controller_inputs(controller, target, poses)
-                for controller in self.controllers]
+      inputs = [
+        self._controller_inputs(controller, target, poses) for controller in self.controllers
+      ]
       if isinstance(self.inverse, progressive.ProgressiveLSTM):
         outputs, self._inverse_state = self.inverse.step_columns(inputs, self._inverse_state)
       else:
@@ -169,7 +178,8 @@ class LearnedAgent(base.Agent):
         outputs, self._inverse_state = [step.action], step.state
       for controller, output in zip(self.controllers, outputs):
         action[list(controller.view.action_indices)] = controller.normalisation.actions.denormalise(
-            output[0].numpy().astype(float))
+          output[0].numpy().astype(float)
+        )
     action = np.clip(action, -1.0, 1.0)
     action[~np.repeat(self._module_active(), self.robot.actuators_per_module)] = 0.0
     self._previous_target = target
@@ -182,44 +192,59 @@ class LearnedAgent(base.Agent):
     active = np.ones(self.robot.num_modules, dtype=bool)
     if self.active_modules is not None:
       if not set(self.active_modules) <= set(range(1, self.robot.num_modules + 1)):
-        raise ValueError(f"active modules must lie in 1 to {self.robot.num_modules} for "
-                         f"{self.robot.name}, got {tuple(self.active_modules)}")
+        raise ValueError(
+          f"active modules must lie in 1 to {self.robot.num_modules} for "
+          f"{self.robot.name}, got {tuple(self.active_modules)}"
+        )
       active[:] = False
       active[np.array(list(self.active_modules), dtype=int) - 1] = True
     return active
 
-  def _controller_inputs(self, controller: Controller, target: np.ndarray,
-                         poses: np.ndarray) -> torch.Tensor:
+  def _controller_inputs(
+    self, controller: Controller, target: np.ndarray, poses: np.ndarray
+  ) -> torch.Tensor:
     """The controller's normalised input [x*_{t+1}, e_t, a_{t-1}], (1, input_size)."""
     view, scale = controller.view, controller.normalisation
     as_tensor = lambda values: torch.as_tensor(values, dtype=torch.float32)[None]
     pick = lambda full: scale.poses.normalise(view.select(full, self._previous_action)[0])
     _, previous_own, previous_preceding = view.select(poses, self._previous_action)
-    previous_action = scale.actions.normalise(previous_own) if self._previous_target is not None \
-        else np.zeros(view.action_size)
+    previous_action = (
+      scale.actions.normalise(previous_own)
+      if self._previous_target is not None
+      else np.zeros(view.action_size)
+    )
     error = np.zeros(view.pose_size)
     if self._previous_target is not None and self.error_source == "physics":
       error = pick(self._previous_target) - pick(poses)
     elif self._previous_target is not None and self.error_source == "model":
       # x'_t = forward(x_{t-2}, x_{t-1}, actuation a_{t-1}), one step behind as in training.
-      actuation = np.concatenate([scale.preceding_actions.normalise(previous_preceding),
-                                  previous_action])
+      actuation = np.concatenate(
+        [scale.preceding_actions.normalise(previous_preceding), previous_action]
+      )
       predicted, controller.forward_state = controller.forward.step(
-          as_tensor(pick(self._poses_before)), as_tensor(pick(self._previous_poses)),
-          as_tensor(actuation), controller.forward_state)
+        as_tensor(pick(self._poses_before)),
+        as_tensor(pick(self._previous_poses)),
+        as_tensor(actuation),
+        controller.forward_state,
+      )
       error = pick(self._previous_target) - predicted[0].numpy()
-    return smpl_windows.inverse_inputs(as_tensor(pick(target)), as_tensor(error),
-                                       as_tensor(previous_action))
+    return smpl_windows.inverse_inputs(
+      as_tensor(pick(target)), as_tensor(error), as_tensor(previous_action)
+    )
 
 
-def training_configs(seed: int, profile: profiles.Profile, params: dict | None = None
-                     ) -> tuple[training.ForwardTrainingConfig, training.InverseTrainingConfig]:
+def training_configs(
+  seed: int, profile: profiles.Profile, params: dict | None = None
+) -> tuple[training.ForwardTrainingConfig, training.InverseTrainingConfig]:
   """The forward model's config (the paper's, always) and the inverse model's (with ``params``'
   optimiser settings; ``hyperparameters.values``), seeded by ``seed``."""
-  common = dict(max_epochs=profile.max_epochs, patience=profile.patience, seed=seed,
-                compile=profile.compile)
-  return (training.ForwardTrainingConfig(**common), training.InverseTrainingConfig(
-      **common, **hyperparameters.training_settings(params or {})))
+  common = dict(
+    max_epochs=profile.max_epochs, patience=profile.patience, seed=seed, compile=profile.compile
+  )
+  return (
+    training.ForwardTrainingConfig(**common),
+    training.InverseTrainingConfig(**common, **hyperparameters.training_settings(params or {})),
+  )
 
 
 def forward_config(seed: int, profile: profiles.Profile) -> training.ForwardTrainingConfig:
@@ -231,8 +256,9 @@ def _input_size(view: data.View) -> int:
   return smpl_windows.inverse_input_size(view.pose_size, view.action_size)
 
 
-def _inverse_model(views: list[data.View], per_module: bool, make_model: ModelFactory,
-                   params: dict) -> InverseModel:
+def _inverse_model(
+  views: list[data.View], per_module: bool, make_model: ModelFactory, params: dict
+) -> InverseModel:
   """An untrained inverse model for the views: a column per module (the paper's width and
   depth), or one centralised model configured by ``params``' model settings."""
   if per_module:
@@ -244,12 +270,15 @@ def _inverse_model(views: list[data.View], per_module: bool, make_model: ModelFa
   return make_model(_input_size(view), view.action_size, **hyperparameters.model_settings(params))
 
 
-def untrained(views: list[data.View], per_module: bool, make_model: ModelFactory | None,
-              params: dict) -> tuple[InverseModel, list[smpl_forward.ForwardModel]]:
+def untrained(
+  views: list[data.View], per_module: bool, make_model: ModelFactory | None, params: dict
+) -> tuple[InverseModel, list[smpl_forward.ForwardModel]]:
   """Untrained inverse (configured by ``params``) and forward models for ``views``, to load a
   checkpoint into."""
-  forwards = [smpl_forward.ForwardModel(view.preceding_action_size + view.action_size,
-                                        view.pose_size) for view in views]
+  forwards = [
+    smpl_forward.ForwardModel(view.preceding_action_size + view.action_size, view.pose_size)
+    for view in views
+  ]
   return _inverse_model(views, per_module, make_model, params), forwards
 
 
@@ -263,35 +292,70 @@ def progress_bar(label: str, epochs: int, show: bool):
   return progress.EpochProgressBar(label, epochs) if show else contextlib.nullcontext(None)
 
 
-def _train(name: str, robot: robot_base.SoftArm, views: list[data.View], seed: int,
-           profile: profiles.Profile, per_module: bool, make_model: ModelFactory, params: dict,
-           show: bool
-           ) -> tuple[InverseModel, list[smpl_forward.ForwardModel], list[data.Normalisation]]:
+def _train(
+  name: str,
+  robot: robot_base.SoftArm,
+  views: list[data.View],
+  seed: int,
+  profile: profiles.Profile,
+  per_module: bool,
+  make_model: ModelFactory,
+  params: dict,
+  show: bool,
+) -> tuple[InverseModel, list[smpl_forward.ForwardModel], list[data.Normalisation]]:
   """Collects or finds the dataset, then trains (or finds) the forward models and trains the
   inverse model (module docstring)."""
   windows, forwards = trained_forward_models(robot, views, seed, profile, show)
-  inverse, _ = train_inverse(views, windows, forwards, seed, profile, per_module, make_model,
-                             params, f"{name} {robot.name} seed {seed}" if show else None)
+  inverse, _ = train_inverse(
+    views,
+    windows,
+    forwards,
+    seed,
+    profile,
+    per_module,
+    make_model,
+    params,
+    f"{name} {robot.name} seed {seed}" if show else None,
+  )
   return inverse, forwards, [split.normalisation for split in windows]
 
 
-def trained_forward_models(robot: robot_base.SoftArm, views: list[data.View], seed: int,
-                           profile: profiles.Profile, show_progress: bool = False
-                           ) -> tuple[list[data.SplitWindows], list[smpl_forward.ForwardModel]]:
+def trained_forward_models(
+  robot: robot_base.SoftArm,
+  views: list[data.View],
+  seed: int,
+  profile: profiles.Profile,
+  show_progress: bool = False,
+) -> tuple[list[data.SplitWindows], list[smpl_forward.ForwardModel]]:
   """Each view's windows of the profile's babbling dataset (collected or found) and its frozen
   forward model, trained with ``forward_config(seed, profile)`` or found in the cache that every
   agent and tuning trial reading the same view shares (``forward_models``)."""
   dataset = data.collect(robot, samples=profile.samples, seed=DATA_SEED, progress=show_progress)
-  return forward_models.prepare(robot, views, dataset, profile.samples, DATA_SEED,
-                                forward_config(seed, profile), TRAINING_VERSION,
-                                f"forward {robot.name} seed {seed}" if show_progress else None)
+  return forward_models.prepare(
+    robot,
+    views,
+    dataset,
+    profile.samples,
+    DATA_SEED,
+    forward_config(seed, profile),
+    TRAINING_VERSION,
+    f"forward {robot.name} seed {seed}" if show_progress else None,
+  )
 
 
-def train_inverse(views: list[data.View], windows: list[data.SplitWindows],
-                  forwards: list[smpl_forward.ForwardModel], seed: int, profile: profiles.Profile,
-                  per_module: bool, make_model: ModelFactory | None, params: dict,
-                  progress_label: str | None = None, on_epoch: EpochCallback | None = None,
-                  restart_diverged: bool = True) -> tuple[InverseModel, float]:
+def train_inverse(
+  views: list[data.View],
+  windows: list[data.SplitWindows],
+  forwards: list[smpl_forward.ForwardModel],
+  seed: int,
+  profile: profiles.Profile,
+  per_module: bool,
+  make_model: ModelFactory | None,
+  params: dict,
+  progress_label: str | None = None,
+  on_epoch: EpochCallback | None = None,
+  restart_diverged: bool = True,
+) -> tuple[InverseModel, float]:
   """Trains a fresh inverse model with hyperparameters ``params`` in closed loop through the
   frozen forward models (one per view); returns it and its validation loss. A diverged training
   starts again with half the learning rate (``restart_diverged``; ``smpl.training``), which a
@@ -314,69 +378,105 @@ def train_inverse(views: list[data.View], windows: list[data.SplitWindows],
     label = f"inverse {progress_label} {view.name}"
     with progress_bar(label, profile.max_epochs, progress_label is not None) as bar:
       epoch_end = _epoch_callback(
-          bar, on_epoch, index * profile.max_epochs,
-          lambda loss: _action_weighted(best_losses + [loss], action_sizes))
+        bar,
+        on_epoch,
+        index * profile.max_epochs,
+        lambda loss: _action_weighted(best_losses + [loss], action_sizes),
+      )
       if per_module:  # Column by column, all acting together; the earlier ones stay frozen.
         inverse.columns.requires_grad_(False)
         inverse.columns[index].requires_grad_(True)
         result = training.train_column_jointly(
-            inverse, forwards[:index + 1],
-            smpl_windows.ModuleWindows(tuple(split.train for split in windows[:index + 1])),
-            smpl_windows.ModuleWindows(tuple(split.validation for split in windows[:index + 1])),
-            inverse_config, device, epoch_end, restart_diverged=restart_diverged)
+          inverse,
+          forwards[: index + 1],
+          smpl_windows.ModuleWindows(tuple(split.train for split in windows[: index + 1])),
+          smpl_windows.ModuleWindows(tuple(split.validation for split in windows[: index + 1])),
+          inverse_config,
+          device,
+          epoch_end,
+          restart_diverged=restart_diverged,
+        )
       else:
-        result = training.train_inverse_model(inverse, forwards[index], windows[index].train,
-                                              windows[index].validation, inverse_config, device,
-                                              epoch_end, restart_diverged)
+        result = training.train_inverse_model(
+          inverse,
+          forwards[index],
+          windows[index].train,
+          windows[index].validation,
+          inverse_config,
+          device,
+          epoch_end,
+          restart_diverged,
+        )
     best_losses.append(result.best_validation_loss)
   inverse.requires_grad_(False)
   return inverse, _action_weighted(best_losses, action_sizes)
 
 
-def _epoch_callback(bar, on_epoch: EpochCallback | None, first_epoch: int,
-                    loss_so_far: Callable[[float], float]
-                    ) -> Callable[[training.EpochReport], None]:
+def _epoch_callback(
+  bar, on_epoch: EpochCallback | None, first_epoch: int, loss_so_far: Callable[[float], float]
+) -> Callable[[training.EpochReport], None]:
   """``smpl.training.fit``'s epoch callback: advances the progress bar, then calls ``on_epoch``."""
+
   def epoch_end(report: training.EpochReport) -> None:
     if bar is not None:
       bar(report)
     if on_epoch is not None:
       on_epoch(first_epoch + report.epoch, loss_so_far(report.validation_loss))
+
   return epoch_end
 
 
 def _action_weighted(losses: list[float], action_sizes: list[int]) -> float:
   """Mean of per-view action MSEs weighted by action count: the MSE over all their actions."""
-  sizes = action_sizes[:len(losses)]
+  sizes = action_sizes[: len(losses)]
   return sum(loss * size for loss, size in zip(losses, sizes)) / sum(sizes)
 
 
-def trained_config(name: str, robot: robot_base.SoftArm, views: list[data.View], seed: int,
-                   profile: profiles.Profile, params: dict) -> TrainedConfig:
+def trained_config(
+  name: str,
+  robot: robot_base.SoftArm,
+  views: list[data.View],
+  seed: int,
+  profile: profiles.Profile,
+  params: dict,
+) -> TrainedConfig:
   """The config that names the checkpoint of agent ``name`` trained with these settings."""
-  return TrainedConfig(name, robot.name, hashlib.sha256(robot.to_xml().encode()).hexdigest(),
-                       tuple(view.name for view in views), profile.samples, seed,
-                       profile.max_epochs, profile.patience, profile.compile,
-                       tuple(sorted(params.items())))
+  return TrainedConfig(
+    name,
+    robot.name,
+    hashlib.sha256(robot.to_xml().encode()).hexdigest(),
+    tuple(view.name for view in views),
+    profile.samples,
+    seed,
+    profile.max_epochs,
+    profile.patience,
+    profile.compile,
+    tuple(sorted(params.items())),
+  )
 
 
-def checkpoint_path(name: str, robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
-                    per_module: bool) -> pathlib.Path:
+def checkpoint_path(
+  name: str, robot: robot_base.SoftArm, seed: int, profile: profiles.Profile, per_module: bool
+) -> pathlib.Path:
   """Where ``build_agent`` caches the agent's checkpoint (it exists once trained)."""
   views = learners.views(robot, per_module)
-  return checkpoint_file(trained_config(name, robot, views, seed, profile,
-                                        hyperparameters.values(name, robot.name)))
+  return checkpoint_file(
+    trained_config(name, robot, views, seed, profile, hyperparameters.values(name, robot.name))
+  )
 
 
-def cache_files(name: str, robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
-                per_module: bool) -> list[tuple[pathlib.Path, str]]:
+def cache_files(
+  name: str, robot: robot_base.SoftArm, seed: int, profile: profiles.Profile, per_module: bool
+) -> list[tuple[pathlib.Path, str]]:
   """The files the data home caches for agent ``name`` of ``seed``, each with its zoo kind: the
   agent's checkpoint, then the forward models it trains through."""
   views = learners.views(robot, per_module)
-  forwards = forward_models.configs(robot, views, profile.samples, DATA_SEED,
-                                    forward_config(seed, profile), TRAINING_VERSION)
-  return ([(checkpoint_path(name, robot, seed, profile, per_module), "agent")]
-          + [(forward_models.cache_file(config), "forward") for config in forwards])
+  forwards = forward_models.configs(
+    robot, views, profile.samples, DATA_SEED, forward_config(seed, profile), TRAINING_VERSION
+  )
+  return [(checkpoint_path(name, robot, seed, profile, per_module), "agent")] + [
+    (forward_models.cache_file(config), "forward") for config in forwards
+  ]
 
 
 def checkpoint_file(config: TrainedConfig) -> pathlib.Path:
@@ -388,16 +488,20 @@ def checkpoint_file(config: TrainedConfig) -> pathlib.Path:
 class TrainedModels:
   """What a checkpoint holds: the inverse model, the forward models, the normalisation of each
   named part (a view, or a robot of a protocol) and any further named arrays."""
+
   inverse: InverseModel
   forwards: list[smpl_forward.ForwardModel]
   normalisations: list[data.Normalisation]
   arrays: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
 
 
-def load_or_train(path: pathlib.Path, config, parts: list[str],
-                  untrained_models: Callable[[], tuple[InverseModel,
-                                                       list[smpl_forward.ForwardModel]]],
-                  train: Callable[[], TrainedModels]) -> TrainedModels:
+def load_or_train(
+  path: pathlib.Path,
+  config,
+  parts: list[str],
+  untrained_models: Callable[[], tuple[InverseModel, list[smpl_forward.ForwardModel]]],
+  train: Callable[[], TrainedModels],
+) -> TrainedModels:
   """The models of the checkpoint at ``path`` (saved for ``config``; taken from the zoo if the
   data home lacks it, ``softbench.zoo``), loaded into ``untrained_models()``. Otherwise, or if
   the file is damaged in any way (``storage.read_cached``: one ``CorruptFileWarning``),
@@ -409,11 +513,19 @@ def load_or_train(path: pathlib.Path, config, parts: list[str],
   def read(found: pathlib.Path) -> TrainedModels:
     inverse, forwards = untrained_models()
     stored = checkpoint.load_checkpoint(found, bundle(inverse, forwards), config)
-    normalisations = [data.Normalisation.from_arrays(
-        {key.removeprefix(f"{part}/"): value for key, value in stored.items()
-         if key.startswith(f"{part}/")}) for part in parts]
-    arrays = {key: np.asarray(value) for key, value in stored.items()
-              if key.split("/")[0] not in parts}
+    normalisations = [
+      data.Normalisation.from_arrays(
+        {
+          key.removeprefix(f"{part}/"): value
+          for key, value in stored.items()
+          if key.startswith(f"{part}/")
+        }
+      )
+      for part in parts
+    ]
+    arrays = {
+      key: np.asarray(value) for key, value in stored.items() if key.split("/")[0] not in parts
+    }
     return TrainedModels(inverse, forwards, normalisations, arrays)
 
   cached = storage.read_cached(path, read, "checkpoint", "training it again")
@@ -423,10 +535,14 @@ def load_or_train(path: pathlib.Path, config, parts: list[str],
     models = train()
   if set(key.split("/")[0] for key in models.arrays) & set(parts):
     raise ValueError(f"further arrays {sorted(models.arrays)} clash with the parts {parts}")
-  scales = {f"{part}/{key}": value for part, scale in zip(parts, models.normalisations)
-            for key, value in scale.to_arrays().items()}
-  checkpoint.save_checkpoint(path, bundle(models.inverse, models.forwards), config,
-                             {**scales, **models.arrays})
+  scales = {
+    f"{part}/{key}": value
+    for part, scale in zip(parts, models.normalisations)
+    for key, value in scale.to_arrays().items()
+  }
+  checkpoint.save_checkpoint(
+    path, bundle(models.inverse, models.forwards), config, {**scales, **models.arrays}
+  )
   snapshots.discard(snapshot_folder(path))
   return models
 
@@ -437,22 +553,36 @@ def snapshot_folder(checkpoint_path: pathlib.Path) -> pathlib.Path:
   return checkpoint_path.with_suffix(".partial")
 
 
-def build_agent(name: str, robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
-                per_module: bool, make_model: ModelFactory | None = None,
-                show_progress: bool = False) -> LearnedAgent:
+def build_agent(
+  name: str,
+  robot: robot_base.SoftArm,
+  seed: int,
+  profile: profiles.Profile,
+  per_module: bool,
+  make_model: ModelFactory | None = None,
+  show_progress: bool = False,
+) -> LearnedAgent:
   """A trained learned agent: from the checkpoint cache, or trained now and then cached."""
   views = learners.views(robot, per_module)
   params = hyperparameters.values(name, robot.name)
   config = trained_config(name, robot, views, seed, profile, params)
 
   def train() -> TrainedModels:
-    return TrainedModels(*_train(name, robot, views, seed, profile, per_module, make_model,
-                                 params, show_progress))
+    return TrainedModels(
+      *_train(name, robot, views, seed, profile, per_module, make_model, params, show_progress)
+    )
 
-  models = load_or_train(checkpoint_file(config), config, [view.name for view in views],
-                         lambda: untrained(views, per_module, make_model, params), train)
+  models = load_or_train(
+    checkpoint_file(config),
+    config,
+    [view.name for view in views],
+    lambda: untrained(views, per_module, make_model, params),
+    train,
+  )
   inverse, forwards, normalisations = models.inverse, models.forwards, models.normalisations
   inverse.eval()
-  controllers = [Controller(view, forward.eval(), scale)
-                 for view, forward, scale in zip(views, forwards, normalisations)]
+  controllers = [
+    Controller(view, forward.eval(), scale)
+    for view, forward, scale in zip(views, forwards, normalisations)
+  ]
   return LearnedAgent(robot, seed, inverse, controllers)

@@ -7,10 +7,11 @@ agent is first built), and the ``search_space`` of its tuned hyperparameters (``
 searches it with Optuna; the values in use are in ``hyperparameters.json``).
 """
 
+from collections.abc import Callable
+from collections.abc import Mapping
 import dataclasses
 import importlib
 import numbers
-from collections.abc import Callable, Mapping
 
 from softbench import data
 from softbench.robots import base as robot_base
@@ -27,8 +28,11 @@ class LogUniform:
     return trial.suggest_float(name, self.low, self.high, log=True)
 
   def contains(self, value) -> bool:
-    return (isinstance(value, numbers.Real) and not isinstance(value, bool)
-            and self.low <= value <= self.high)
+    return (
+      isinstance(value, numbers.Real)
+      and not isinstance(value, bool)
+      and self.low <= value <= self.high
+    )
 
   def describe(self) -> str:
     return f"log-uniform {self.low:g} .. {self.high:g}"
@@ -45,18 +49,23 @@ class Choice:
 
   def contains(self, value) -> bool:
     # An integer option takes only an integer (a batch size of 32.0 is refused).
-    return (not isinstance(value, bool) and isinstance(value, numbers.Real)
-            and any(value == option and (isinstance(value, int) or not isinstance(option, int))
-                    for option in self.values))
+    return (
+      not isinstance(value, bool)
+      and isinstance(value, numbers.Real)
+      and any(
+        value == option and (isinstance(value, int) or not isinstance(option, int))
+        for option in self.values
+      )
+    )
 
   def describe(self) -> str:
     return "one of " + ", ".join(f"{value:g}" for value in self.values)
 
 
 OPTIMISATION = {
-    "learning_rate": LogUniform(1e-4, 1e-2),
-    "batch_size": Choice((32, 64, 128)),  # 16 left out: it doubles a trial's time (docs/tuning.md).
-    "weight_decay": Choice((0.0, 1e-6, 1e-5, 1e-4)),
+  "learning_rate": LogUniform(1e-4, 1e-2),
+  "batch_size": Choice((32, 64, 128)),  # 16 left out: it doubles a trial's time (docs/tuning.md).
+  "weight_decay": Choice((0.0, 1e-6, 1e-5, 1e-4)),
 }
 """The optimiser's tuned settings, shared by every learner (``smpl.training``)."""
 RECURRENT = {"hidden_size": Choice((16, 32, 64, 128)), "num_layers": Choice((1, 2, 3))}
@@ -66,8 +75,11 @@ RECURRENT = {"hidden_size": Choice((16, 32, 64, 128)), "num_layers": Choice((1, 
 def views(robot: robot_base.SoftArm, per_module: bool) -> list:
   """What the controllers read: module k's inputs for column k (``per_module``), else the whole
   arm's (``softbench.data.View``)."""
-  return ([data.View.module(robot, k) for k in range(1, robot.num_modules + 1)]
-          if per_module else [data.View.whole_arm(robot)])
+  return (
+    [data.View.module(robot, k) for k in range(1, robot.num_modules + 1)]
+    if per_module
+    else [data.View.whole_arm(robot)]
+  )
 
 
 @dataclasses.dataclass(frozen=True)

@@ -26,7 +26,8 @@ class RandomAgent(base.Agent):
     return self._rng.uniform(-1.0, 1.0, self.robot.action_dim)
 
 
-def build(robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
-          show_progress: bool = False) -> base.Agent:
+def build(
+  robot: robot_base.SoftArm, seed: int, profile: profiles.Profile, show_progress: bool = False
+) -> base.Agent:
   del profile, show_progress  # Nothing to train.
   return RandomAgent(robot, seed)

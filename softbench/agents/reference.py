@@ -86,16 +86,19 @@ class ReferenceAgent(base.Agent):
     self._threads = threads or os.cpu_count() or 1
     self._physics = None
     self._scored = np.arange(robot.num_modules)
-    self._restart_starts = np.vstack([
+    self._restart_starts = np.vstack(
+      [
         np.zeros(robot.action_dim),
-        np.random.default_rng(RESTART_SEED).uniform(-1.0, 1.0,
-                                                    (RESTART_SAMPLES, robot.action_dim))])
+        np.random.default_rng(RESTART_SEED).uniform(-1.0, 1.0, (RESTART_SAMPLES, robot.action_dim)),
+      ]
+    )
     self._forget()
 
   def bind(self, physics) -> None:
     self._physics = physics
-    self._recorder = recorder.PoseRecorder(self.robot, self._threads,
-                                           model=copy.copy(physics.model.ptr))
+    self._recorder = recorder.PoseRecorder(
+      self.robot, self._threads, model=copy.copy(physics.model.ptr)
+    )
     self._state = np.empty(self._recorder.state_size)
 
   def reset(self, episode: base.EpisodeInfo) -> None:
@@ -108,12 +111,12 @@ class ReferenceAgent(base.Agent):
     self._memory_features = None
     self._restarted = False
 
-  def _simulate(self, actions: np.ndarray, orientation: bool,
-                remember: bool = True) -> np.ndarray:
+  def _simulate(self, actions: np.ndarray, orientation: bool, remember: bool = True) -> np.ndarray:
     """(batch, features) after holding each action (batch, action_dim) for one control period:
     scored tip positions over the arm length, then weighted orientation vectors."""
-    poses, _ = self._recorder.record(actions[:, None],
-                                     np.broadcast_to(self._state, (len(actions), len(self._state))))
+    poses, _ = self._recorder.record(
+      actions[:, None], np.broadcast_to(self._state, (len(actions), len(self._state)))
+    )
     scored = poses[:, -1, self._scored]
     features = [scored[..., :3].reshape(len(actions), -1) / self.robot.length]
     if orientation:
@@ -136,13 +139,15 @@ class ReferenceAgent(base.Agent):
     """Forward-difference Jacobian (features, action_dim) and the features at ``action``."""
     steps = np.where(action + FD_STEP <= 1.0, FD_STEP, -FD_STEP)
     # Only the unperturbed action is remembered: its perturbations would crowd the nearest.
-    features = self._simulate(np.vstack([action, action + np.diag(steps)]), orientation,
-                              remember=False)
+    features = self._simulate(
+      np.vstack([action, action + np.diag(steps)]), orientation, remember=False
+    )
     self._remember(action[None], features[:1])
     return ((features[1:] - features[0]) / steps[:, None]).T, features[0]
 
-  def _step(self, jacobian: np.ndarray, residual: np.ndarray, damping: float,
-            action: np.ndarray) -> np.ndarray:
+  def _step(
+    self, jacobian: np.ndarray, residual: np.ndarray, damping: float, action: np.ndarray
+  ) -> np.ndarray:
     """The next action: argmin |J d - r|^2 + damping^2 |d|^2 + effort^2 |a + d|^2 over the
     entries not pressed against a bound, shortened to ``MAX_STEP`` and clipped to [-1, 1]."""
     effort = EFFORT * min(1.0, mujoco.mju_norm(residual) / EFFORT_SCALE)
@@ -150,8 +155,9 @@ class ReferenceAgent(base.Agent):
     step = np.zeros(len(action))
     for _ in range(len(action)):
       step[:] = 0.0
-      step[free] = _damped_least_squares(jacobian[:, free], residual, damping**2 + effort**2,
-                                         effort**2 * action[free])
+      step[free] = _damped_least_squares(
+        jacobian[:, free], residual, damping**2 + effort**2, effort**2 * action[free]
+      )
       pressed = free & (((action >= 1.0) & (step > 0)) | ((action <= -1.0) & (step < 0)))
       if not pressed.any() or pressed.all():
         break
@@ -177,8 +183,9 @@ class ReferenceAgent(base.Agent):
       action = self._restart(goal, action, residual, orientation)
     return action
 
-  def _restart(self, goal: np.ndarray, action: np.ndarray, residual: float,
-               orientation: bool) -> np.ndarray:
+  def _restart(
+    self, goal: np.ndarray, action: np.ndarray, residual: float, orientation: bool
+  ) -> np.ndarray:
     """The better of ``action`` (residual ``residual``) and a search of up to
     ``RESTART_ITERATIONS`` steps from the best of: ``action``, the zero action and either the
     fixed sampled actions (the episode's first restart) or the ``RESTART_CANDIDATES``
@@ -195,8 +202,9 @@ class ReferenceAgent(base.Agent):
     restarted, restarted_residual = self._search(goal, start, orientation, RESTART_ITERATIONS)
     return restarted if restarted_residual < residual else action
 
-  def _search(self, goal: np.ndarray, action: np.ndarray, orientation: bool,
-              iterations: int) -> tuple[np.ndarray, float]:
+  def _search(
+    self, goal: np.ndarray, action: np.ndarray, orientation: bool, iterations: int
+  ) -> tuple[np.ndarray, float]:
     """Up to ``iterations`` damped least-squares steps from ``action`` towards ``goal``: the
     action reached and the norm of its residual (arm lengths)."""
     jacobian, feature = self._linearise(action, orientation)
@@ -212,8 +220,9 @@ class ReferenceAgent(base.Agent):
         step = candidate - action
         predicted_change = np.empty(len(feature))
         mujoco.mju_mulMatVec(predicted_change, jacobian, step)
-        jacobian = jacobian + np.outer(candidate_feature - feature - predicted_change,
-                                       step) / mujoco.mju_dot(step, step)
+        jacobian = jacobian + np.outer(
+          candidate_feature - feature - predicted_change, step
+        ) / mujoco.mju_dot(step, step)
         action, feature, residual = candidate, candidate_feature, goal - candidate_feature
         fresh = False
       elif not fresh:
@@ -224,8 +233,9 @@ class ReferenceAgent(base.Agent):
     return action, mujoco.mju_norm(residual)
 
 
-def _damped_least_squares(jacobian: np.ndarray, residual: np.ndarray, regulariser: float,
-                          pull: np.ndarray) -> np.ndarray:
+def _damped_least_squares(
+  jacobian: np.ndarray, residual: np.ndarray, regulariser: float, pull: np.ndarray
+) -> np.ndarray:
   """The step d solving (J^T J + regulariser I) d = J^T residual - pull, by Cholesky.
 
   MuJoCo's own routines, not numpy's: numpy's products and solves run through OpenBLAS, which picks
@@ -246,7 +256,8 @@ def _damped_least_squares(jacobian: np.ndarray, residual: np.ndarray, regularise
   return step
 
 
-def build(robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
-          show_progress: bool = False) -> base.Agent:
+def build(
+  robot: robot_base.SoftArm, seed: int, profile: profiles.Profile, show_progress: bool = False
+) -> base.Agent:
   del profile, show_progress  # Nothing to train: the agent plans on the simulator.
   return ReferenceAgent(robot, seed)

@@ -20,8 +20,8 @@ import time
 
 import numpy as np
 import stable_baselines3
-import torch
 from stable_baselines3.common import vec_env
+import torch
 
 from smpl import snapshots
 from smpl import training
@@ -41,17 +41,20 @@ LEARNING_STARTS = {"paper": 5_000, "default": 2_000, "tiny": 50}  # Random steps
 CHUNK_STEPS = 1_000  # Steps per `learn` call; the state may be saved after each (a multiple of
 # EPISODE_STEPS, so that saves fall between episodes).
 HYPERPARAMETERS = {
-    "learning_rate": 3e-4, "batch_size": 256, "tau": 0.005, "train_freq": 1,
-    "gradient_steps": 1,
-    # The pose after a step depends mostly on that step's action (the arms settle within one
-    # control period, tendon-5 in 0.72 s of 1 s), so little reward lies beyond a few steps.
-    "gamma": 0.9,
-    "net_arch": (256, 256),
-    # The task's reward is small far from the target (0.02 at 24 % of the arm length), next to
-    # SAC's entropy bonus: scaled by the running std of the discounted return (SB3's
-    # VecNormalize, rewards only), a 6,000-step probe on tendon-1 tracked the spiral to 7.7 mm
-    # (unscaled: 12.1 mm; the zero agent 12.9 mm) and the babbling task to 13.1 mm (24.8; 27.5).
-    "normalise_reward": True,
+  "learning_rate": 3e-4,
+  "batch_size": 256,
+  "tau": 0.005,
+  "train_freq": 1,
+  "gradient_steps": 1,
+  # The pose after a step depends mostly on that step's action (the arms settle within one
+  # control period, tendon-5 in 0.72 s of 1 s), so little reward lies beyond a few steps.
+  "gamma": 0.9,
+  "net_arch": (256, 256),
+  # The task's reward is small far from the target (0.02 at 24 % of the arm length), next to
+  # SAC's entropy bonus: scaled by the running std of the discounted return (SB3's
+  # VecNormalize, rewards only), a 6,000-step probe on tendon-1 tracked the spiral to 7.7 mm
+  # (unscaled: 12.1 mm; the zero agent 12.9 mm) and the babbling task to 13.1 mm (24.8; 27.5).
+  "normalise_reward": True,
 }
 TRAINING_VERSION = 1  # Bump when training changes, so that cached models are not reused.
 SPENT = ("environment_steps", "episodes", "wall_time_s")  # What a trained model records of its
@@ -59,8 +62,7 @@ SPENT = ("environment_steps", "episodes", "wall_time_s")  # What a trained model
 _FORMAT = "softbench-sac"
 
 
-def policy_input(flat: np.ndarray, shapes: dict[str, tuple[int, ...]],
-                 length: float) -> np.ndarray:
+def policy_input(flat: np.ndarray, shapes: dict[str, tuple[int, ...]], length: float) -> np.ndarray:
   """The policy's input: a flat observation (``environment.flatten``) of parts of ``shapes``,
   every position (the first 3 columns of poses and targets) divided by the arm ``length`` (m),
   as float32."""
@@ -94,16 +96,25 @@ class TrainingConfig:
     return f"sac-{self.robot}-seed{self.seed}-{hashlib.sha256(text).hexdigest()[:12]}"
 
 
-def training_config(robot: robot_base.SoftArm, seed: int,
-                    profile: profiles.Profile) -> TrainingConfig:
-  return TrainingConfig(robot.name, hashlib.sha256(robot.to_xml().encode()).hexdigest(),
-                        profile.samples, seed, STEPS[profile.name], LEARNING_STARTS[profile.name],
-                        EPISODE_STEPS, tuple(sorted(HYPERPARAMETERS.items())),
-                        stable_baselines3.__version__.split(".")[0])
+def training_config(
+  robot: robot_base.SoftArm, seed: int, profile: profiles.Profile
+) -> TrainingConfig:
+  return TrainingConfig(
+    robot.name,
+    hashlib.sha256(robot.to_xml().encode()).hexdigest(),
+    profile.samples,
+    seed,
+    STEPS[profile.name],
+    LEARNING_STARTS[profile.name],
+    EPISODE_STEPS,
+    tuple(sorted(HYPERPARAMETERS.items())),
+    stable_baselines3.__version__.split(".")[0],
+  )
 
 
-def checkpoint_path(robot: robot_base.SoftArm, seed: int, profile: profiles.Profile
-                    ) -> pathlib.Path:
+def checkpoint_path(
+  robot: robot_base.SoftArm, seed: int, profile: profiles.Profile
+) -> pathlib.Path:
   """Where the trained model of ``seed`` is cached (it exists once trained)."""
   key = training_config(robot, seed, profile).key
   return storage.softbench_home() / learned.CHECKPOINT_FOLDER / f"{key}.pt"
@@ -130,33 +141,42 @@ class _PolicyInput(vec_env.VecEnvWrapper):
     return self._scaled(observations), rewards, dones, infos
 
 
-def _training_env(robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
-                  first_episode: int) -> tuple[vec_env.VecEnv, streams.TargetStreamEnv]:
-  dataset = data.collect(robot.name, samples=profile.samples, seed=learned.DATA_SEED,
-                         progress=False)
-  stream_env = streams.TargetStreamEnv(robot, streams.training_targets(dataset, EPISODE_STEPS),
-                                       EPISODE_STEPS, seed, first_episode)
+def _training_env(
+  robot: robot_base.SoftArm, seed: int, profile: profiles.Profile, first_episode: int
+) -> tuple[vec_env.VecEnv, streams.TargetStreamEnv]:
+  dataset = data.collect(
+    robot.name, samples=profile.samples, seed=learned.DATA_SEED, progress=False
+  )
+  stream_env = streams.TargetStreamEnv(
+    robot, streams.training_targets(dataset, EPISODE_STEPS), EPISODE_STEPS, seed, first_episode
+  )
   venv = vec_env.DummyVecEnv([lambda: stream_env])
   scaled = _PolicyInput(venv, stream_env.observation_shapes, robot.length)
   if HYPERPARAMETERS["normalise_reward"]:
-    scaled = vec_env.VecNormalize(scaled, norm_obs=False, norm_reward=True,
-                                  gamma=HYPERPARAMETERS["gamma"])
+    scaled = vec_env.VecNormalize(
+      scaled, norm_obs=False, norm_reward=True, gamma=HYPERPARAMETERS["gamma"]
+    )
   return scaled, stream_env
 
 
 def _model_kwargs() -> dict:
   values = dict(HYPERPARAMETERS)
-  return {**{key: value for key, value in values.items()
-             if key not in ("net_arch", "normalise_reward")},
-          "policy_kwargs": {"net_arch": list(values["net_arch"])}}
+  return {
+    **{key: value for key, value in values.items() if key not in ("net_arch", "normalise_reward")},
+    "policy_kwargs": {"net_arch": list(values["net_arch"])},
+  }
 
 
 def _reward_scale(venv: vec_env.VecEnv) -> dict | None:
   """The running statistics of the reward normalisation, if any."""
   if not isinstance(venv, vec_env.VecNormalize):
     return None
-  return {"mean": venv.ret_rms.mean, "var": venv.ret_rms.var, "count": venv.ret_rms.count,
-          "returns": venv.returns}
+  return {
+    "mean": venv.ret_rms.mean,
+    "var": venv.ret_rms.var,
+    "count": venv.ret_rms.count,
+    "returns": venv.returns,
+  }
 
 
 def _restore_reward_scale(venv: vec_env.VecEnv, saved: dict | None) -> None:
@@ -167,8 +187,12 @@ def _restore_reward_scale(venv: vec_env.VecEnv, saved: dict | None) -> None:
 
 def _random_states(model) -> dict:
   numpy_state = np.random.get_state(legacy=False)
-  return {"torch": torch.get_rng_state(), "numpy": numpy_state, "python": random.getstate(),
-          "action_space": model.action_space.np_random.bit_generator.state}
+  return {
+    "torch": torch.get_rng_state(),
+    "numpy": numpy_state,
+    "python": random.getstate(),
+    "action_space": model.action_space.np_random.bit_generator.state,
+  }
 
 
 def _restore_random_states(model, states: dict) -> None:
@@ -181,50 +205,80 @@ def _restore_random_states(model, states: dict) -> None:
 def _read(path: pathlib.Path, config: TrainingConfig, kind: str) -> dict:
   """The saved dict at ``path``, checked to be of ``kind`` and made for ``config``."""
   saved = torch.load(path, map_location="cpu", weights_only=False)
-  if (not isinstance(saved, dict) or saved.get("format") != _FORMAT or saved.get("kind") != kind
-      or saved.get("config") != dataclasses.asdict(config)):
+  if (
+    not isinstance(saved, dict)
+    or saved.get("format") != _FORMAT
+    or saved.get("kind") != kind
+    or saved.get("config") != dataclasses.asdict(config)
+  ):
     raise ValueError("not a sac model of this configuration")
   return saved
 
 
-def _save_state(path: pathlib.Path, config: TrainingConfig, model, stream_env, elapsed: float,
-                last_observation: np.ndarray) -> None:
+def _save_state(
+  path: pathlib.Path,
+  config: TrainingConfig,
+  model,
+  stream_env,
+  elapsed: float,
+  last_observation: np.ndarray,
+) -> None:
   model_bytes, buffer_bytes = io.BytesIO(), io.BytesIO()
   model.save(model_bytes)
   model.save_replay_buffer(buffer_bytes)
-  state = {"format": _FORMAT, "kind": "training-state", "config": dataclasses.asdict(config),
-           "model": model_bytes.getvalue(), "replay_buffer": buffer_bytes.getvalue(),
-           "random": _random_states(model), "reward_scale": _reward_scale(model.get_env()),
-           # Saves fall between episodes: the one under way has just begun, and a resumed
-           # training begins it again, at the observation the model holds.
-           "episode_under_way": stream_env.episodes_started - 1,
-           "last_observation": last_observation, "wall_time_s": elapsed}
+  state = {
+    "format": _FORMAT,
+    "kind": "training-state",
+    "config": dataclasses.asdict(config),
+    "model": model_bytes.getvalue(),
+    "replay_buffer": buffer_bytes.getvalue(),
+    "random": _random_states(model),
+    "reward_scale": _reward_scale(model.get_env()),
+    # Saves fall between episodes: the one under way has just begun, and a resumed
+    # training begins it again, at the observation the model holds.
+    "episode_under_way": stream_env.episodes_started - 1,
+    "last_observation": last_observation,
+    "wall_time_s": elapsed,
+  }
   content = io.BytesIO()
   torch.save(state, content)
   storage.write_cache_file(path, content.getvalue(), "sac training state")
 
 
-def train(robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
-          show_progress: bool = False) -> dict:
+def train(
+  robot: robot_base.SoftArm, seed: int, profile: profiles.Profile, show_progress: bool = False
+) -> dict:
   """The trained model of ``seed`` (its saved dict): from the cache, or trained now (resuming a
   saved state) and cached."""
   config = training_config(robot, seed, profile)
   path = checkpoint_path(robot, seed, profile)
-  finished = storage.read_cached(path, lambda file: _read(file, config, "model"),
-                                 "cached sac model", "training it again")
+  finished = storage.read_cached(
+    path, lambda file: _read(file, config, "model"), "cached sac model", "training it again"
+  )
   if finished is not None:
     return finished
   partial = path.with_suffix(".partial.pt")
-  state = storage.read_cached(partial, lambda file: _read(file, config, "training-state"),
-                              "sac training state", "training from the start")
+  state = storage.read_cached(
+    partial,
+    lambda file: _read(file, config, "training-state"),
+    "sac training state",
+    "training from the start",
+  )
   device = training.default_device()
   with training.limited_cpu_threads(training.CPU_THREADS, device):
-    venv, stream_env = _training_env(robot, seed, profile,
-                                     state["episode_under_way"] if state else 0)
+    venv, stream_env = _training_env(
+      robot, seed, profile, state["episode_under_way"] if state else 0
+    )
     if state is None:
-      model = stable_baselines3.SAC("MlpPolicy", venv, seed=seed, device=device,
-                                    buffer_size=config.steps,
-                                    learning_starts=config.learning_starts, **_model_kwargs())
+      model = stable_baselines3.SAC(
+        "MlpPolicy",
+        venv,
+        seed=seed,
+        device=device,
+        buffer_size=config.steps,
+        learning_starts=config.learning_starts,
+        **_model_kwargs(),
+      )
       elapsed = 0.0
     else:
       model = stable_baselines3.SAC.load(io.BytesIO(state["model"]), env=venv, device=device)
@@ -235,27 +289,38 @@ def train(robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
       if isinstance(venv, vec_env.VecNormalize):
         model._last_original_obs = venv.get_original_obs()  # pylint: disable=protected-access
       if not np.array_equal(first, state["last_observation"]):
-        raise RuntimeError(f"{partial}: the resumed episode does not start where the saved "
-                           "training stopped; delete the file to train from the start")
+        raise RuntimeError(
+          f"{partial}: the resumed episode does not start where the saved "
+          "training stopped; delete the file to train from the start"
+        )
       elapsed = state["wall_time_s"]
     started, saved_at = time.perf_counter() - elapsed, time.monotonic()
-    with progress_bars.SampleProgress(f"sac {robot.name} seed {seed}", config.steps,
-                                      model.num_timesteps, show_progress) as bar:
+    with progress_bars.SampleProgress(
+      f"sac {robot.name} seed {seed}", config.steps, model.num_timesteps, show_progress
+    ) as bar:
       while model.num_timesteps < config.steps:
         chunk = min(CHUNK_STEPS, config.steps - model.num_timesteps)
         model.learn(chunk, reset_num_timesteps=False)
         bar.update(model.num_timesteps)
-        if (model.num_timesteps < config.steps
-            and time.monotonic() - saved_at >= snapshots.SAVE_INTERVAL_S):
-          _save_state(partial, config, model, stream_env, time.perf_counter() - started,
-                      model._last_obs)  # pylint: disable=protected-access
+        if (
+          model.num_timesteps < config.steps
+          and time.monotonic() - saved_at >= snapshots.SAVE_INTERVAL_S
+        ):
+          _save_state(
+            partial, config, model, stream_env, time.perf_counter() - started, model._last_obs
+          )  # pylint: disable=protected-access
           saved_at = time.monotonic()
   model_bytes = io.BytesIO()
   model.save(model_bytes, exclude=["replay_buffer"])
-  finished = {"format": _FORMAT, "kind": "model", "config": dataclasses.asdict(config),
-              "model": model_bytes.getvalue(), "environment_steps": int(model.num_timesteps),
-              "episodes": stream_env.episodes_started,
-              "wall_time_s": round(time.perf_counter() - started, 3)}
+  finished = {
+    "format": _FORMAT,
+    "kind": "model",
+    "config": dataclasses.asdict(config),
+    "model": model_bytes.getvalue(),
+    "environment_steps": int(model.num_timesteps),
+    "episodes": stream_env.episodes_started,
+    "wall_time_s": round(time.perf_counter() - started, 3),
+  }
   content = io.BytesIO()
   torch.save(finished, content)
   storage.write_cache_file(path, content.getvalue(), "cached sac model")
@@ -284,24 +349,30 @@ class SACAgent(base.Agent):
       self._start = np.array(observation["poses"], dtype=float)
     given = np.asarray(observation["target"], dtype=float)
     target = self._start.copy()
-    target[self._scored, :given.shape[1]] = given
+    target[self._scored, : given.shape[1]] = given
     whole = {**observation, "target": target}
     shapes = {key: np.shape(whole[key]) for key in environment.KEYS}
     action, _ = self._model.predict(
-        policy_input(environment.flatten(whole), shapes, self.robot.length), deterministic=True)
+      policy_input(environment.flatten(whole), shapes, self.robot.length), deterministic=True
+    )
     return np.asarray(action, dtype=np.float64)
 
 
-def build(robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
-          show_progress: bool = False) -> base.Agent:
+def build(
+  robot: robot_base.SoftArm, seed: int, profile: profiles.Profile, show_progress: bool = False
+) -> base.Agent:
   return SACAgent(robot, seed, train(robot, seed, profile, show_progress))
 
 
-def training_summary(robot: robot_base.SoftArm, seed: int, profile: profiles.Profile
-                     ) -> dict | None:
+def training_summary(
+  robot: robot_base.SoftArm, seed: int, profile: profiles.Profile
+) -> dict | None:
   """The environment steps, episodes and wall time of ``seed``'s cached model; None if absent."""
   config = training_config(robot, seed, profile)
-  saved = storage.read_cached(checkpoint_path(robot, seed, profile),
-                              lambda file: _read(file, config, "model"), "cached sac model",
-                              "training it again")
+  saved = storage.read_cached(
+    checkpoint_path(robot, seed, profile),
+    lambda file: _read(file, config, "model"),
+    "cached sac model",
+    "training it again",
+  )
   return None if saved is None else {key: saved[key] for key in SPENT}

@@ -14,7 +14,8 @@ class ZeroAgent(base.Agent):
     return np.zeros(self.robot.action_dim)
 
 
-def build(robot: robot_base.SoftArm, seed: int, profile: profiles.Profile,
-          show_progress: bool = False) -> base.Agent:
+def build(
+  robot: robot_base.SoftArm, seed: int, profile: profiles.Profile, show_progress: bool = False
+) -> base.Agent:
   del profile, show_progress  # Nothing to train.
   return ZeroAgent(robot, seed)

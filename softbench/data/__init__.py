@@ -40,12 +40,35 @@ _VIEWS = ("SplitWindows", "View", "windows")  # In data.views, which needs torch
 def __getattr__(name: str):
   if name in _VIEWS:
     from softbench.data import views  # pylint: disable=import-outside-toplevel
+
     return getattr(views, name)
   raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-__all__ = ["BABBLING_STREAM", "CHUNK_LENGTH", "DEFAULT_SAMPLES", "EPISODE_LENGTH", "FRACTIONS",
-           "HELD_OUT_BABBLING_STREAM", "SPLITS", "CorruptFileWarning", "Dataset", "DatasetError",
-           "MinMaxNormaliser", "Normalisation", "Piece", "SplitWindows", "View",
-           "babbling_actions", "collect", "dataset_folder", "episode_lengths",
-           "generating_config", "load", "read", "rng", "split_pieces", "windows"]
+__all__ = [
+  "BABBLING_STREAM",
+  "CHUNK_LENGTH",
+  "DEFAULT_SAMPLES",
+  "EPISODE_LENGTH",
+  "FRACTIONS",
+  "HELD_OUT_BABBLING_STREAM",
+  "SPLITS",
+  "CorruptFileWarning",
+  "Dataset",
+  "DatasetError",
+  "MinMaxNormaliser",
+  "Normalisation",
+  "Piece",
+  "SplitWindows",
+  "View",
+  "babbling_actions",
+  "collect",
+  "dataset_folder",
+  "episode_lengths",
+  "generating_config",
+  "load",
+  "read",
+  "rng",
+  "split_pieces",
+  "windows",
+]

@@ -10,11 +10,11 @@ on the chunking. Every ``chunk_length`` control steps the recording so far is sa
 the same bytes as one that never stopped.
 """
 
+from collections.abc import Sequence
 import os
 import pathlib
 import shutil
 import time
-from collections.abc import Sequence
 
 import numpy as np
 
@@ -29,17 +29,26 @@ from softbench.robots import recorder
 CHUNK_LENGTH = 50  # Control steps between two saved chunks (50 s of tendon babbling).
 
 
-def babbling_actions(robot: robots.SoftArm, seed: int,
-                     lengths: Sequence[int]) -> list[np.ndarray]:
+def babbling_actions(robot: robots.SoftArm, seed: int, lengths: Sequence[int]) -> list[np.ndarray]:
   """Each episode's (length, action_dim) actions, from its own random stream."""
-  return [seeding.rng(seed, seeding.BABBLING_STREAM, episode).uniform(
-      -1.0, 1.0, (length, robot.action_dim)) for episode, length in enumerate(lengths)]
+  return [
+    seeding.rng(seed, seeding.BABBLING_STREAM, episode).uniform(
+      -1.0, 1.0, (length, robot.action_dim)
+    )
+    for episode, length in enumerate(lengths)
+  ]
 
 
-def collect(robot: str | robots.SoftArm, samples: int = dataset.DEFAULT_SAMPLES, seed: int = 0,
-            workers: int | None = None, home: str | pathlib.Path | None = None,
-            progress: bool = True, episode_length: int = dataset.EPISODE_LENGTH,
-            chunk_length: int = CHUNK_LENGTH) -> dataset.Dataset:
+def collect(
+  robot: str | robots.SoftArm,
+  samples: int = dataset.DEFAULT_SAMPLES,
+  seed: int = 0,
+  workers: int | None = None,
+  home: str | pathlib.Path | None = None,
+  progress: bool = True,
+  episode_length: int = dataset.EPISODE_LENGTH,
+  chunk_length: int = CHUNK_LENGTH,
+) -> dataset.Dataset:
   """Collects (or resumes, or finds) the babbling dataset of this config.
 
   Args:
@@ -64,32 +73,56 @@ def collect(robot: str | robots.SoftArm, samples: int = dataset.DEFAULT_SAMPLES,
   dataset.check_count("workers", workers)
   dataset.check_count("chunk_length", chunk_length)
   folder = dataset.dataset_folder(config, home)
-  found = storage.read_cached(folder / dataset.JSON_NAME, lambda _: dataset.read(folder, config),
-                              "dataset", "collecting it again", (folder / dataset.NPZ_NAME,))
+  found = storage.read_cached(
+    folder / dataset.JSON_NAME,
+    lambda _: dataset.read(folder, config),
+    "dataset",
+    "collecting it again",
+    (folder / dataset.NPZ_NAME,),
+  )
   if found is not None:
     return found
   started = time.perf_counter()
   lengths = config["episode_lengths"]
   actions = babbling_actions(arm, seed, lengths)
   pose_recorder = recorder.PoseRecorder(arm, min(workers, len(lengths)))
-  resumed_step, poses_after = _record(pose_recorder, actions, folder / chunks.PARTIAL_FOLDER,
-                                      chunk_length, progress, dataset.dataset_key(config))
+  resumed_step, poses_after = _record(
+    pose_recorder,
+    actions,
+    folder / chunks.PARTIAL_FOLDER,
+    chunk_length,
+    progress,
+    dataset.dataset_key(config),
+  )
   rest_poses = pose_recorder.poses(pose_recorder.rest_state())
-  poses = [np.concatenate([rest_poses[None], poses_after[episode, :length]])
-           for episode, length in enumerate(lengths)]
-  arrays = {"actions": np.concatenate(actions), "poses": np.concatenate(poses),
-            "episode_lengths": np.array(lengths, dtype="<i8")}
-  collection = {"wall_time_s": round(time.perf_counter() - started, 3),
-                "workers": pose_recorder.workers, "resumed_from_step": resumed_step}
+  poses = [
+    np.concatenate([rest_poses[None], poses_after[episode, :length]])
+    for episode, length in enumerate(lengths)
+  ]
+  arrays = {
+    "actions": np.concatenate(actions),
+    "poses": np.concatenate(poses),
+    "episode_lengths": np.array(lengths, dtype="<i8"),
+  }
+  collection = {
+    "wall_time_s": round(time.perf_counter() - started, 3),
+    "workers": pose_recorder.workers,
+    "resumed_from_step": resumed_step,
+  }
   dataset.write(folder, config, arrays, collection)
   result = dataset.read(folder, config)
   shutil.rmtree(folder / chunks.PARTIAL_FOLDER)
   return result
 
 
-def _record(pose_recorder: recorder.PoseRecorder, actions: list[np.ndarray],
-            partial: pathlib.Path, chunk_length: int, show_progress: bool, collection: str
-            ) -> tuple[int, np.ndarray]:
+def _record(
+  pose_recorder: recorder.PoseRecorder,
+  actions: list[np.ndarray],
+  partial: pathlib.Path,
+  chunk_length: int,
+  show_progress: bool,
+  collection: str,
+) -> tuple[int, np.ndarray]:
   """Records every episode chunk by chunk, from the saved chunks of this ``collection`` (its
   dataset key) on.
 
@@ -100,10 +133,14 @@ def _record(pose_recorder: recorder.PoseRecorder, actions: list[np.ndarray],
   lengths = np.array([len(episode) for episode in actions])
   held = np.zeros((len(actions), lengths.max(), pose_recorder.robot.action_dim))
   for episode, episode_actions in enumerate(actions):
-    held[episode, :len(episode_actions)] = episode_actions
-  layout = chunks.Layout(episodes=len(actions), steps=held.shape[1],
-                         num_modules=pose_recorder.robot.num_modules,
-                         state_size=pose_recorder.state_size, collection=collection)
+    held[episode, : len(episode_actions)] = episode_actions
+  layout = chunks.Layout(
+    episodes=len(actions),
+    steps=held.shape[1],
+    num_modules=pose_recorder.robot.num_modules,
+    state_size=pose_recorder.state_size,
+    collection=collection,
+  )
   done = chunks.resume(partial, layout)
   step = done[-1].stop if done else 0
   resumed_step = step
@@ -112,9 +149,13 @@ def _record(pose_recorder: recorder.PoseRecorder, actions: list[np.ndarray],
   def samples_after(steps: int) -> int:
     return int(np.minimum(lengths, steps).sum())
 
-  with progress_bars.SampleProgress(f"babbling {pose_recorder.robot.name}",
-                                    total=int(lengths.sum()), completed=samples_after(step),
-                                    enabled=show_progress) as bar:
+  with progress_bars.SampleProgress(
+    f"babbling {pose_recorder.robot.name}",
+    total=int(lengths.sum()),
+    completed=samples_after(step),
+    enabled=show_progress,
+  ) as bar:
+
     def on_step(_episodes: int) -> None:
       nonlocal step
       step += 1

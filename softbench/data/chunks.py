@@ -38,9 +38,11 @@ class Chunk:
   final_states: np.ndarray
 
   def arrays(self) -> dict[str, np.ndarray]:
-    return {"steps": np.array([self.start, self.stop], dtype="<i8"),
-            "poses": np.asarray(self.poses, dtype="<f8"),
-            "final_states": np.asarray(self.final_states, dtype="<f8")}
+    return {
+      "steps": np.array([self.start, self.stop], dtype="<i8"),
+      "poses": np.asarray(self.poses, dtype="<f8"),
+      "final_states": np.asarray(self.final_states, dtype="<f8"),
+    }
 
 
 @dataclasses.dataclass(frozen=True)
@@ -62,8 +64,9 @@ def write(folder: pathlib.Path, chunk: Chunk, collection: str) -> None:
   """Saves ``chunk`` of the collection keyed ``collection`` (``Layout.collection``)."""
   arrays = {**chunk.arrays(), "collection": np.array(collection)}
   arrays["sha256"] = np.array(storage.arrays_sha256(arrays))
-  storage.write_cache_file(chunk_path(folder, chunk.start, chunk.stop), storage.npz_bytes(arrays),
-                           "babbling chunk")
+  storage.write_cache_file(
+    chunk_path(folder, chunk.start, chunk.stop), storage.npz_bytes(arrays), "babbling chunk"
+  )
 
 
 def read(path: pathlib.Path, layout: Layout) -> Chunk:
@@ -77,10 +80,13 @@ def read(path: pathlib.Path, layout: Layout) -> Chunk:
   if str(arrays.pop("collection")) != layout.collection:
     raise ChunkError(f"a chunk of another collection, not of {layout.collection}")
   start, stop = (int(step) for step in arrays["steps"])
-  if (f"-{start:06d}-{stop:06d}." not in path.name or not 0 <= start < stop <= layout.steps
-      or arrays["poses"].shape != (layout.episodes, stop - start, layout.num_modules,
-                                   recorder.POSE_SIZE)
-      or arrays["final_states"].shape != (layout.episodes, layout.state_size)):
+  if (
+    f"-{start:06d}-{stop:06d}." not in path.name
+    or not 0 <= start < stop <= layout.steps
+    or arrays["poses"].shape
+    != (layout.episodes, stop - start, layout.num_modules, recorder.POSE_SIZE)
+    or arrays["final_states"].shape != (layout.episodes, layout.state_size)
+  ):
     raise ChunkError("does not fit this collection (steps or shapes differ)")
   return Chunk(start, stop, arrays["poses"], arrays["final_states"])
 
@@ -91,12 +97,14 @@ def resume(folder: pathlib.Path, layout: Layout) -> list[Chunk]:
   chain = []
   step = 0
   while step < layout.steps:
-    candidates = sorted(folder.glob(f"chunk-{step:06d}-*.npz"), key=lambda path: path.name,
-                        reverse=True)  # The longest first.
+    candidates = sorted(
+      folder.glob(f"chunk-{step:06d}-*.npz"), key=lambda path: path.name, reverse=True
+    )  # The longest first.
     chunk = None
     for path in candidates:
-      chunk = storage.read_cached(path, lambda found: read(found, layout), "babbling chunk",
-                                  "computing it again")
+      chunk = storage.read_cached(
+        path, lambda found: read(found, layout), "babbling chunk", "computing it again"
+      )
       if chunk is not None:
         break
     if chunk is None:

@@ -38,8 +38,8 @@ import pathlib
 import mujoco
 import numpy as np
 
-import softbench
 from smpl.files import first_line  # An exception's message on one line; used package-wide.
+import softbench
 from softbench import robots
 from softbench import storage
 from softbench.data import seeding
@@ -56,8 +56,7 @@ NPZ_NAME = "dataset.npz"
 JSON_NAME = "dataset.json"
 ACTION_DISTRIBUTION = "uniform in [-1, 1) per entry, held for one control period"
 _HASH_LENGTH = 10  # Hex digits of the config hash in a dataset's folder name.
-_DTYPES = {"actions": np.dtype("<f8"), "poses": np.dtype("<f8"),
-           "episode_lengths": np.dtype("<i8")}
+_DTYPES = {"actions": np.dtype("<f8"), "poses": np.dtype("<f8"), "episode_lengths": np.dtype("<i8")}
 
 
 class DatasetError(ValueError):
@@ -113,7 +112,7 @@ class Dataset:
       raise IndexError(f"episode {index} out of range; the dataset has {self.num_episodes}")
     start = int(np.sum(self.episode_lengths[:index]))
     stop = start + int(self.episode_lengths[index])
-    return self.poses[start + index:stop + index + 1], self.actions[start:stop]
+    return self.poses[start + index : stop + index + 1], self.actions[start:stop]
 
 
 def check_count(name: str, value: int) -> None:
@@ -151,25 +150,29 @@ def resolve_robot(robot: str | robots.SoftArm) -> robots.SoftArm:
   return robots.make(robot)
 
 
-def generating_config(robot: str | robots.SoftArm, samples: int = DEFAULT_SAMPLES,
-                      seed: int = 0, episode_length: int = EPISODE_LENGTH) -> dict:
+def generating_config(
+  robot: str | robots.SoftArm,
+  samples: int = DEFAULT_SAMPLES,
+  seed: int = 0,
+  episode_length: int = EPISODE_LENGTH,
+) -> dict:
   """Everything the dataset's arrays depend on; raises a one-line ValueError on bad arguments."""
   arm = resolve_robot(robot)
   lengths = episode_lengths(samples, episode_length)
   seeding.check_seed(seed)
   return {
-      "format_version": FORMAT_VERSION,
-      "robot": arm.name,
-      "robot_xml_sha256": hashlib.sha256(arm.to_xml().encode()).hexdigest(),
-      "mujoco_version": mujoco.__version__,
-      "num_modules": arm.num_modules,
-      "actuators_per_module": list(arm.actuators_per_module),
-      "control_timestep": arm.control_timestep,
-      "samples": int(samples),
-      "seed": int(seed),
-      "episode_lengths": list(lengths),
-      "action_stream": seeding.BABBLING_STREAM,
-      "action_distribution": ACTION_DISTRIBUTION,
+    "format_version": FORMAT_VERSION,
+    "robot": arm.name,
+    "robot_xml_sha256": hashlib.sha256(arm.to_xml().encode()).hexdigest(),
+    "mujoco_version": mujoco.__version__,
+    "num_modules": arm.num_modules,
+    "actuators_per_module": list(arm.actuators_per_module),
+    "control_timestep": arm.control_timestep,
+    "samples": int(samples),
+    "seed": int(seed),
+    "episode_lengths": list(lengths),
+    "action_stream": seeding.BABBLING_STREAM,
+    "action_distribution": ACTION_DISTRIBUTION,
   }
 
 
@@ -179,8 +182,10 @@ def config_sha256(config: dict) -> str:
 
 def dataset_key(config: dict) -> str:
   """The folder name of the dataset of ``config``."""
-  return (f"{config['robot']}-n{config['samples']}-seed{config['seed']}-"
-          f"{config_sha256(config)[:_HASH_LENGTH]}")
+  return (
+    f"{config['robot']}-n{config['samples']}-seed{config['seed']}-"
+    f"{config_sha256(config)[:_HASH_LENGTH]}"
+  )
 
 
 def dataset_folder(config: dict, home: str | pathlib.Path | None = None) -> pathlib.Path:
@@ -192,29 +197,35 @@ def dataset_folder(config: dict, home: str | pathlib.Path | None = None) -> path
 def expected_shapes(config: dict) -> dict[str, tuple[int, ...]]:
   lengths = config["episode_lengths"]
   samples, episodes = sum(lengths), len(lengths)
-  return {"actions": (samples, sum(config["actuators_per_module"])),
-          "poses": (samples + episodes, config["num_modules"], recorder.POSE_SIZE),
-          "episode_lengths": (episodes,)}
+  return {
+    "actions": (samples, sum(config["actuators_per_module"])),
+    "poses": (samples + episodes, config["num_modules"], recorder.POSE_SIZE),
+    "episode_lengths": (episodes,),
+  }
 
 
-def write(folder: pathlib.Path, config: dict, arrays: dict[str, np.ndarray],
-          collection: dict) -> None:
+def write(
+  folder: pathlib.Path, config: dict, arrays: dict[str, np.ndarray], collection: dict
+) -> None:
   """Writes ``dataset.npz`` then ``dataset.json`` atomically (layout in the module docstring)."""
   content = storage.npz_bytes(arrays)
   storage.write_cache_file(folder / NPZ_NAME, content, "dataset")
   manifest = {
-      "format": FORMAT,
-      "key": dataset_key(config),
-      "config": config,
-      "config_sha256": config_sha256(config),
-      "npz_sha256": hashlib.sha256(content).hexdigest(),
-      "arrays_sha256": storage.arrays_sha256(arrays),
-      "arrays": {name: {"shape": list(array.shape), "dtype": array.dtype.str}
-                 for name, array in sorted(arrays.items())},
-      "collection": {"softbench_version": softbench.__version__, **collection},
+    "format": FORMAT,
+    "key": dataset_key(config),
+    "config": config,
+    "config_sha256": config_sha256(config),
+    "npz_sha256": hashlib.sha256(content).hexdigest(),
+    "arrays_sha256": storage.arrays_sha256(arrays),
+    "arrays": {
+      name: {"shape": list(array.shape), "dtype": array.dtype.str}
+      for name, array in sorted(arrays.items())
+    },
+    "collection": {"softbench_version": softbench.__version__, **collection},
   }
-  storage.write_cache_file(folder / JSON_NAME, json.dumps(manifest, indent=2, sort_keys=True)
-                           + "\n", "dataset's manifest")
+  storage.write_cache_file(
+    folder / JSON_NAME, json.dumps(manifest, indent=2, sort_keys=True) + "\n", "dataset's manifest"
+  )
 
 
 def read(folder: str | pathlib.Path, expected_config: dict | None = None) -> Dataset:
@@ -229,13 +240,18 @@ def read(folder: str | pathlib.Path, expected_config: dict | None = None) -> Dat
   arrays = _read_arrays(folder / NPZ_NAME, manifest, shapes)
   for array in arrays.values():
     array.setflags(write=False)
-  return Dataset(path=folder, config=manifest["config"], collection=manifest["collection"],
-                 **arrays)
+  return Dataset(
+    path=folder, config=manifest["config"], collection=manifest["collection"], **arrays
+  )
 
 
-def load(robot: str | robots.SoftArm, samples: int = DEFAULT_SAMPLES, seed: int = 0,
-         home: str | pathlib.Path | None = None,
-         episode_length: int = EPISODE_LENGTH) -> Dataset:
+def load(
+  robot: str | robots.SoftArm,
+  samples: int = DEFAULT_SAMPLES,
+  seed: int = 0,
+  home: str | pathlib.Path | None = None,
+  episode_length: int = EPISODE_LENGTH,
+) -> Dataset:
   """The verified babbling dataset of this config, collected before by ``collect``.
 
   Raises:
@@ -245,14 +261,18 @@ def load(robot: str | robots.SoftArm, samples: int = DEFAULT_SAMPLES, seed: int 
   config = generating_config(robot, samples, seed, episode_length)
   folder = dataset_folder(config, home)
   if not (folder / JSON_NAME).exists():
-    raise DatasetError(f"{folder}: no dataset collected; run `softbench collect --robot "
-                       f"{config['robot']} --samples {samples} --seed {seed}`")
+    raise DatasetError(
+      f"{folder}: no dataset collected; run `softbench collect --robot "
+      f"{config['robot']} --samples {samples} --seed {seed}`"
+    )
   return read(folder, config)
 
 
-def _read_manifest(path: pathlib.Path, expected_config: dict | None
-                   ) -> tuple[dict, dict[str, tuple[int, ...]]]:
+def _read_manifest(
+  path: pathlib.Path, expected_config: dict | None
+) -> tuple[dict, dict[str, tuple[int, ...]]]:
   """The checked manifest and the array shapes its config implies."""
+
   def fail(problem: str) -> DatasetError:
     return DatasetError(f"{path}: {problem}")
 
@@ -264,33 +284,45 @@ def _read_manifest(path: pathlib.Path, expected_config: dict | None
     raise fail(f"not readable JSON (truncated or corrupt): {first_line(error)}") from None
   if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
     raise fail("not a softbench babbling dataset manifest")
-  for field, kind in (("key", str), ("config", dict), ("config_sha256", str),
-                      ("npz_sha256", str), ("arrays_sha256", str), ("arrays", dict),
-                      ("collection", dict)):
+  for field, kind in (
+    ("key", str),
+    ("config", dict),
+    ("config_sha256", str),
+    ("npz_sha256", str),
+    ("arrays_sha256", str),
+    ("arrays", dict),
+    ("collection", dict),
+  ):
     if not isinstance(manifest.get(field), kind):
       raise fail(f"field {field!r} missing or not a {kind.__name__}")
   config = manifest["config"]
   if config.get("format_version") != FORMAT_VERSION:
-    raise fail(f"format version {config.get('format_version')!r}; this softbench reads "
-               f"version {FORMAT_VERSION}")
+    raise fail(
+      f"format version {config.get('format_version')!r}; this softbench reads "
+      f"version {FORMAT_VERSION}"
+    )
   if config_sha256(config) != manifest["config_sha256"]:
     raise fail("config does not match its sha256 (edited or corrupt)")
   if manifest["key"] != dataset_key(config) or path.parent.name != manifest["key"]:
-    raise fail(f"key {manifest['key']!r} does not match its config and folder "
-               f"{path.parent.name!r}")
+    raise fail(f"key {manifest['key']!r} does not match its config and folder {path.parent.name!r}")
   if expected_config is not None and config != expected_config:
-    field = next(name for name in sorted(set(config) | set(expected_config))
-                 if config.get(name) != expected_config.get(name))
-    raise fail(f"generated with {field} = {config.get(field)!r}, expected "
-               f"{expected_config.get(field)!r}")
+    field = next(
+      name
+      for name in sorted(set(config) | set(expected_config))
+      if config.get(name) != expected_config.get(name)
+    )
+    raise fail(
+      f"generated with {field} = {config.get(field)!r}, expected {expected_config.get(field)!r}"
+    )
   try:
     return manifest, expected_shapes(config)
   except (KeyError, TypeError) as error:
     raise fail(f"malformed config: {error!r}") from None
 
 
-def _read_arrays(path: pathlib.Path, manifest: dict,
-                 shapes: dict[str, tuple[int, ...]]) -> dict[str, np.ndarray]:
+def _read_arrays(
+  path: pathlib.Path, manifest: dict, shapes: dict[str, tuple[int, ...]]
+) -> dict[str, np.ndarray]:
   def fail(problem: str) -> DatasetError:
     return DatasetError(f"{path}: {problem}")
 
@@ -310,10 +342,12 @@ def _read_arrays(path: pathlib.Path, manifest: dict,
     raise fail(f"holds arrays {sorted(arrays)}, expected {sorted(_DTYPES)}")
   for name, array in arrays.items():
     if array.dtype != _DTYPES[name] or array.shape != shapes[name]:
-      raise fail(f"{name} is {array.dtype.str} {array.shape}, expected {_DTYPES[name].str} "
-                 f"{shapes[name]}")
-  described = {name: {"shape": list(array.shape), "dtype": array.dtype.str}
-               for name, array in arrays.items()}
+      raise fail(
+        f"{name} is {array.dtype.str} {array.shape}, expected {_DTYPES[name].str} {shapes[name]}"
+      )
+  described = {
+    name: {"shape": list(array.shape), "dtype": array.dtype.str} for name, array in arrays.items()
+  }
   if manifest["arrays"] != described:
     raise fail(f"arrays do not match their description in {JSON_NAME}")
   if storage.arrays_sha256(arrays) != manifest["arrays_sha256"]:

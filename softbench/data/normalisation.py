@@ -24,8 +24,11 @@ class MinMaxNormaliser:
   maximum: np.ndarray
 
   def __post_init__(self):
-    if (np.ndim(self.minimum) != 1 or np.shape(self.minimum) != np.shape(self.maximum)
-        or np.any(np.asarray(self.maximum) < np.asarray(self.minimum))):
+    if (
+      np.ndim(self.minimum) != 1
+      or np.shape(self.minimum) != np.shape(self.maximum)
+      or np.any(np.asarray(self.maximum) < np.asarray(self.minimum))
+    ):
       raise ValueError("minimum and maximum must be 1-D, of one shape, minimum <= maximum")
 
   @classmethod
@@ -59,13 +62,17 @@ class MinMaxNormaliser:
     return np.asarray(values, dtype=float) * self._half_range + self._centre
 
   def to_arrays(self, prefix: str = "") -> dict[str, np.ndarray]:
-    return {f"{prefix}minimum": np.array(self.minimum, dtype=float),
-            f"{prefix}maximum": np.array(self.maximum, dtype=float)}
+    return {
+      f"{prefix}minimum": np.array(self.minimum, dtype=float),
+      f"{prefix}maximum": np.array(self.maximum, dtype=float),
+    }
 
   @classmethod
   def from_arrays(cls, arrays: dict[str, np.ndarray], prefix: str = "") -> "MinMaxNormaliser":
-    return cls(np.array(arrays[f"{prefix}minimum"], dtype=float),
-               np.array(arrays[f"{prefix}maximum"], dtype=float))
+    return cls(
+      np.array(arrays[f"{prefix}minimum"], dtype=float),
+      np.array(arrays[f"{prefix}maximum"], dtype=float),
+    )
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -79,10 +86,17 @@ class Normalisation:
 
   def to_arrays(self) -> dict[str, np.ndarray]:
     """Flat named arrays, e.g. for ``smpl.checkpoint.save_checkpoint(normalisation=...)``."""
-    return {name: array for field in dataclasses.fields(self)
-            for name, array in getattr(self, field.name).to_arrays(f"{field.name}_").items()}
+    return {
+      name: array
+      for field in dataclasses.fields(self)
+      for name, array in getattr(self, field.name).to_arrays(f"{field.name}_").items()
+    }
 
   @classmethod
   def from_arrays(cls, arrays: dict[str, np.ndarray]) -> "Normalisation":
-    return cls(**{field.name: MinMaxNormaliser.from_arrays(arrays, f"{field.name}_")
-                  for field in dataclasses.fields(cls)})
+    return cls(
+      **{
+        field.name: MinMaxNormaliser.from_arrays(arrays, f"{field.name}_")
+        for field in dataclasses.fields(cls)
+      }
+    )

@@ -22,15 +22,16 @@ class SampleProgress:
 
   def __init__(self, description: str, total: int, completed: int = 0, enabled: bool = True):
     self._progress = rich_progress.Progress(
-        rich_progress.TextColumn("{task.description}"),
-        rich_progress.BarColumn(),
-        rich_progress.MofNCompleteColumn(),
-        _RateColumn(),
-        rich_progress.TimeElapsedColumn(),
-        rich_progress.TextColumn("ETA"),
-        rich_progress.TimeRemainingColumn(),
-        console=rich_console.Console(stderr=True),
-        disable=not enabled)
+      rich_progress.TextColumn("{task.description}"),
+      rich_progress.BarColumn(),
+      rich_progress.MofNCompleteColumn(),
+      _RateColumn(),
+      rich_progress.TimeElapsedColumn(),
+      rich_progress.TextColumn("ETA"),
+      rich_progress.TimeRemainingColumn(),
+      console=rich_console.Console(stderr=True),
+      disable=not enabled,
+    )
     self._task = self._progress.add_task(description, total=total, completed=completed)
 
   def __enter__(self) -> "SampleProgress":

@@ -25,8 +25,7 @@ MAX_SEED = 2**32 - 1  # The largest seed every consumer takes (numpy's RandomSta
 def check_seed(seed: int) -> None:
   """The one seed rule of softbench: an integer from 0 to ``MAX_SEED``; a one-line ValueError
   otherwise (a bool, a float, a string, a negative or too large number)."""
-  if (isinstance(seed, bool) or not isinstance(seed, numbers.Integral)
-      or not 0 <= seed <= MAX_SEED):
+  if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or not 0 <= seed <= MAX_SEED:
     shown = repr(seed) if len(repr(seed)) <= 40 else f"{repr(seed)[:40]}..."
     raise ValueError(f"seed must be an integer from 0 to {MAX_SEED}, got {shown}")
 

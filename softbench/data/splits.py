@@ -11,8 +11,8 @@ a_start .. a_{stop-1} and poses x_start .. x_stop, each action with its outcome;
 two pieces of an episode meet ends the one and starts the other.
 """
 
-import dataclasses
 from collections.abc import Sequence
+import dataclasses
 
 import numpy as np
 
@@ -37,11 +37,12 @@ class Piece:
   def recording(self, data: dataset.Dataset) -> tuple[np.ndarray, np.ndarray]:
     """Poses (samples + 1, num_modules, 6) and actions (samples, action_dim) of the piece."""
     poses, actions = data.episode(self.episode)
-    return poses[self.start:self.stop + 1], actions[self.start:self.stop]
+    return poses[self.start : self.stop + 1], actions[self.start : self.stop]
 
 
-def split_pieces(episode_lengths: Sequence[int],
-                 fractions: Sequence[float] = FRACTIONS) -> dict[str, list[Piece]]:
+def split_pieces(
+  episode_lengths: Sequence[int], fractions: Sequence[float] = FRACTIONS
+) -> dict[str, list[Piece]]:
   """The pieces of each split (named as in ``SPLITS``) of episodes of these lengths."""
   if len(fractions) != len(SPLITS) or not np.isclose(sum(fractions), 1.0):
     raise ValueError(f"need {len(SPLITS)} fractions summing to 1, got {tuple(fractions)}")
@@ -55,6 +56,5 @@ def split_pieces(episode_lengths: Sequence[int],
       start = max(split_start, episode_start)
       stop = min(split_stop, episode_start + lengths[episode])
       if start < stop:
-        pieces[split].append(Piece(episode, int(start - episode_start),
-                                   int(stop - episode_start)))
+        pieces[split].append(Piece(episode, int(start - episode_start), int(stop - episode_start)))
   return pieces

@@ -52,12 +52,19 @@ class View:
   @classmethod
   def module(cls, robot: robots.SoftArm, module: int) -> "View":
     """Module ``module`` (1 at the base) of ``robot``."""
-    if (isinstance(module, bool) or not isinstance(module, numbers.Integral)
-        or not 1 <= module <= robot.num_modules):
+    if (
+      isinstance(module, bool)
+      or not isinstance(module, numbers.Integral)
+      or not 1 <= module <= robot.num_modules
+    ):
       raise ValueError(f"module must be 1 to {robot.num_modules} for {robot.name}, got {module!r}")
     slices = robot.module_action_slices()
-    return cls(f"module-{module}", (module - 1,), _indices(slices[module - 1:module]),
-               _indices(slices[:module - 1]))
+    return cls(
+      f"module-{module}",
+      (module - 1,),
+      _indices(slices[module - 1 : module]),
+      _indices(slices[: module - 1]),
+    )
 
   @classmethod
   def whole_arm(cls, robot: robots.SoftArm) -> "View":
@@ -75,15 +82,18 @@ class View:
   def preceding_action_size(self) -> int:
     return len(self.preceding_action_indices)
 
-  def select(self, poses: np.ndarray, actions: np.ndarray
-             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+  def select(
+    self, poses: np.ndarray, actions: np.ndarray
+  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The view of poses (..., num_modules, 6) and actions (..., action_dim): its poses
     (..., pose_size), actions (..., action_size) and preceding actions."""
     seen = np.asarray(poses)[..., list(self.pose_modules), :]
     actions = np.asarray(actions)
-    return (seen.reshape(seen.shape[:-2] + (self.pose_size,)),
-            actions[..., list(self.action_indices)],
-            actions[..., list(self.preceding_action_indices)])
+    return (
+      seen.reshape(seen.shape[:-2] + (self.pose_size,)),
+      actions[..., list(self.action_indices)],
+      actions[..., list(self.preceding_action_indices)],
+    )
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -97,10 +107,14 @@ class SplitWindows:
   normalisation: normalisation.Normalisation
 
 
-def windows(data: dataset.Dataset, view: View,
-            window_length: int = smpl_windows.SEQUENCE_LENGTH, stride: int = 1,
-            fractions: tuple[float, ...] = splits.FRACTIONS,
-            fitted: normalisation.Normalisation | None = None) -> SplitWindows:
+def windows(
+  data: dataset.Dataset,
+  view: View,
+  window_length: int = smpl_windows.SEQUENCE_LENGTH,
+  stride: int = 1,
+  fractions: tuple[float, ...] = splits.FRACTIONS,
+  fitted: normalisation.Normalisation | None = None,
+) -> SplitWindows:
   """``view``'s windows of each split of ``data`` (see the module docstring), normalised with
   ``fitted`` if given (e.g. a trained controller's, to retrain it on new data) instead of
   statistics fitted on this dataset's training split.
@@ -108,21 +122,29 @@ def windows(data: dataset.Dataset, view: View,
   Raises:
     ValueError: the view does not fit the dataset, or a split holds no window.
   """
-  if (max(view.pose_modules) >= data.num_modules or
-      max(view.action_indices + view.preceding_action_indices) >= data.action_dim):
-    raise ValueError(f"view {view.name} does not fit {data.robot_name} ({data.num_modules} "
-                     f"modules, {data.action_dim} actions)")
-  recordings = {split: [view.select(*piece.recording(data)) for piece in pieces]
-                for split, pieces in splits.split_pieces(data.episode_lengths, fractions).items()}
+  if (
+    max(view.pose_modules) >= data.num_modules
+    or max(view.action_indices + view.preceding_action_indices) >= data.action_dim
+  ):
+    raise ValueError(
+      f"view {view.name} does not fit {data.robot_name} ({data.num_modules} "
+      f"modules, {data.action_dim} actions)"
+    )
+  recordings = {
+    split: [view.select(*piece.recording(data)) for piece in pieces]
+    for split, pieces in splits.split_pieces(data.episode_lengths, fractions).items()
+  }
 
   def fit(part: int) -> normalisation.MinMaxNormaliser:
     return normalisation.MinMaxNormaliser.fit(
-        np.concatenate([recording[part] for recording in recordings["train"]]))
+      np.concatenate([recording[part] for recording in recordings["train"]])
+    )
 
   if fitted is None:
     fitted = normalisation.Normalisation(poses=fit(0), actions=fit(1), preceding_actions=fit(2))
-  cut = {split: _cut(split, recordings[split], fitted, window_length, stride)
-         for split in splits.SPLITS}
+  cut = {
+    split: _cut(split, recordings[split], fitted, window_length, stride) for split in splits.SPLITS
+  }
   return SplitWindows(view=view, normalisation=fitted, **cut)
 
 
@@ -139,20 +161,34 @@ def _with_unused_last(actions: np.ndarray) -> np.ndarray:
   return np.concatenate([actions, np.zeros_like(actions[:1])])
 
 
-def _cut(split: str, recordings: list[tuple[np.ndarray, np.ndarray, np.ndarray]],
-         fitted: normalisation.Normalisation, window_length: int,
-         stride: int) -> smpl_windows.BabblingWindows:
+def _cut(
+  split: str,
+  recordings: list[tuple[np.ndarray, np.ndarray, np.ndarray]],
+  fitted: normalisation.Normalisation,
+  window_length: int,
+  stride: int,
+) -> smpl_windows.BabblingWindows:
   """Normalised windows of every piece long enough for one, concatenated."""
-  batches = [smpl_windows.BabblingWindows.from_recording(
+  batches = [
+    smpl_windows.BabblingWindows.from_recording(
       _tensor(fitted.poses.normalise(poses)),
       _tensor(_with_unused_last(fitted.actions.normalise(actions))),
       _tensor(_with_unused_last(fitted.preceding_actions.normalise(preceding))),
-      window_length, stride)
-      for poses, actions, preceding in recordings if len(actions) > window_length]
+      window_length,
+      stride,
+    )
+    for poses, actions, preceding in recordings
+    if len(actions) > window_length
+  ]
   if not batches:
     samples = sum(len(actions) for _, actions, _ in recordings)
-    raise ValueError(f"the {split} split ({samples} samples) holds no window of "
-                     f"{window_length} steps; collect more samples")
+    raise ValueError(
+      f"the {split} split ({samples} samples) holds no window of "
+      f"{window_length} steps; collect more samples"
+    )
   return smpl_windows.BabblingWindows(
-      *(torch.cat([getattr(batch, field) for batch in batches])
-        for field in ("poses", "actions", "preceding_actions")))
+    *(
+      torch.cat([getattr(batch, field) for batch in batches])
+      for field in ("poses", "actions", "preceding_actions")
+    )
+  )

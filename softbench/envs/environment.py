@@ -18,8 +18,8 @@ always False). ``reset(seed=s)`` starts the episode that ``suite.load(..., seed=
 from typing import Any
 
 import gymnasium
-import numpy as np
 from gymnasium import spaces
+import numpy as np
 
 from softbench import robots
 from softbench import suite
@@ -53,7 +53,7 @@ def _pose_box(spec, robot: robots.SoftArm) -> spaces.Box:
   components within a unit vector's (and its tolerance)."""
   reach = trajectories.REACH_FACTOR * robot.length
   unit = 1.0 + trajectories.UNIT_TOLERANCE
-  row = np.array([reach] * 3 + [unit] * 3)[:spec.shape[-1]]
+  row = np.array([reach] * 3 + [unit] * 3)[: spec.shape[-1]]
   high = np.broadcast_to(row, spec.shape).astype(spec.dtype)
   return spaces.Box(-high, high, spec.shape, spec.dtype)
 
@@ -78,15 +78,25 @@ class SoftArmEnv(gymnasium.Env):
 
   metadata = {"render_modes": list(RENDER_MODES), "render_fps": None}
 
-  def __init__(self, robot: str | robots.SoftArm, task: str, observation: str = "flat",
-               render_mode: str | None = None, width: int | None = None,
-               height: int | None = None, camera: str | None = None, **task_options):
+  def __init__(
+    self,
+    robot: str | robots.SoftArm,
+    task: str,
+    observation: str = "flat",
+    render_mode: str | None = None,
+    width: int | None = None,
+    height: int | None = None,
+    camera: str | None = None,
+    **task_options,
+  ):
     if observation not in OBSERVATION_FORMS:
-      raise ValueError(f"observation must be one of {', '.join(OBSERVATION_FORMS)}, "
-                       f"got {observation!r}")
+      raise ValueError(
+        f"observation must be one of {', '.join(OBSERVATION_FORMS)}, got {observation!r}"
+      )
     if render_mode is not None and render_mode not in RENDER_MODES:
-      raise ValueError(f"render_mode must be None or one of {', '.join(RENDER_MODES)}, "
-                       f"got {render_mode!r}")
+      raise ValueError(
+        f"render_mode must be None or one of {', '.join(RENDER_MODES)}, got {render_mode!r}"
+      )
     self.robot = robots.make(robot) if isinstance(robot, str) else robot
     self.task_name = task
     self._environment = suite.load(self.robot, task, **task_options)
@@ -96,19 +106,22 @@ class SoftArmEnv(gymnasium.Env):
     named = self._environment.observation_spec()
     action = named["previous_action"]
     named_spaces = {
-        "poses": _pose_box(named["poses"], self.robot),
-        "target": _pose_box(named["target"], self.robot),
-        "previous_action": spaces.Box(float(action.minimum), float(action.maximum), action.shape,
-                                      action.dtype)}
+      "poses": _pose_box(named["poses"], self.robot),
+      "target": _pose_box(named["target"], self.robot),
+      "previous_action": spaces.Box(
+        float(action.minimum), float(action.maximum), action.shape, action.dtype
+      ),
+    }
     self.observation_shapes = {key: tuple(named[key].shape) for key in KEYS}
     self.observation_layout = layout(self.observation_shapes)
     if observation == "dict":
       self.observation_space = spaces.Dict(named_spaces)
     else:
       self.observation_space = spaces.Box(
-          np.concatenate([space.low.ravel() for space in named_spaces.values()]),
-          np.concatenate([space.high.ravel() for space in named_spaces.values()]),
-          dtype=np.float64)
+        np.concatenate([space.low.ravel() for space in named_spaces.values()]),
+        np.concatenate([space.high.ravel() for space in named_spaces.values()]),
+        dtype=np.float64,
+      )
     action = self._environment.action_spec()
     self.action_space = spaces.Box(-1.0, 1.0, action.shape, np.float32)
     self._view = None
@@ -131,8 +144,9 @@ class SoftArmEnv(gymnasium.Env):
   def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
     """Starts an episode; ``seed`` gives the start and targets ``suite.load(seed=seed)`` gives."""
     if options:
-      raise ValueError(f"reset takes no options, got {sorted(options)}; pass task options to "
-                       "gymnasium.make")
+      raise ValueError(
+        f"reset takes no options, got {sorted(options)}; pass task options to gymnasium.make"
+      )
     if seed is not None:
       seeding.check_seed(seed)
       self._environment.task.reseed(seed)
@@ -148,8 +162,7 @@ class SoftArmEnv(gymnasium.Env):
       raise RuntimeError("the episode has ended (or not started); call reset() first")
     time_step = self._environment.step(np.asarray(action, dtype=np.float64))
     self._ended = time_step.last()
-    return self._observation(time_step.observation), float(time_step.reward), False, \
-        self._ended, {}
+    return self._observation(time_step.observation), float(time_step.reward), False, self._ended, {}
 
   def render(self) -> np.ndarray | None:
     """(height, width, 3) uint8: the arm and the current targets, with render_mode

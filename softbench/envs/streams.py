@@ -25,8 +25,10 @@ def training_targets(data: babbling_dataset.Dataset, episode_steps: int) -> list
   targets = [piece.recording(data)[0][1:] for piece in pieces]
   usable = [piece for piece in targets if len(piece) >= episode_steps]
   if not usable:
-    raise ValueError(f"no training piece of {data.path} holds {episode_steps} steps; collect "
-                     "more samples or shorten the episodes")
+    raise ValueError(
+      f"no training piece of {data.path} holds {episode_steps} steps; collect "
+      "more samples or shorten the episodes"
+    )
   return usable
 
 
@@ -47,8 +49,14 @@ class TargetStreamEnv(gymnasium.Env):
 
   metadata = {"render_modes": []}
 
-  def __init__(self, robot: robots.SoftArm, stream: list[np.ndarray], episode_steps: int,
-               seed: int, first_episode: int = 0):
+  def __init__(
+    self,
+    robot: robots.SoftArm,
+    stream: list[np.ndarray],
+    episode_steps: int,
+    seed: int,
+    first_episode: int = 0,
+  ):
     seeding.check_seed(seed)
     if not all(len(piece) >= episode_steps for piece in stream) or not stream:
       raise ValueError(f"every piece of the stream needs at least {episode_steps} targets")
@@ -69,7 +77,7 @@ class TargetStreamEnv(gymnasium.Env):
     draw = seeding.rng(self._seed, seeding.TARGET_STREAM_EPISODES, episode)
     piece = self._stream[draw.choice(len(self._stream), p=self._weights)]
     start = int(draw.integers(0, len(piece) - self.episode_steps + 1))
-    return piece[start:start + self.episode_steps], int(draw.integers(0, seeding.MAX_SEED))
+    return piece[start : start + self.episode_steps], int(draw.integers(0, seeding.MAX_SEED))
 
   def reset(self, *, seed=None, options=None):
     del seed, options  # The episodes are the seed's sequence (class docstring).

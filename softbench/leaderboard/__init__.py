@@ -32,19 +32,23 @@ def build(results: pathlib.Path = DEFAULT_RESULTS) -> ranking.Leaderboard:
   return ranking.rank(records.read_folder(results))
 
 
-def write(board: ranking.Leaderboard, results: pathlib.Path = DEFAULT_RESULTS,
-          out: pathlib.Path = DEFAULT_OUT) -> list[pathlib.Path]:
+def write(
+  board: ranking.Leaderboard,
+  results: pathlib.Path = DEFAULT_RESULTS,
+  out: pathlib.Path = DEFAULT_OUT,
+) -> list[pathlib.Path]:
   """Writes ``README.md`` and ``index.html`` of ``board`` into ``out`` (atomically); returns
   their paths. Links to records and videos are relative to ``out``."""
   out = pathlib.Path(out)
   if out.exists() and not out.is_dir():
     raise ValueError(f"{out}: not a folder; --out takes the folder of the pages")
-  pages = {"README.md": markdown_page.render(board, results, out),
-           "index.html": html_page.render(board, results, out)}
+  pages = {
+    "README.md": markdown_page.render(board, results, out),
+    "index.html": html_page.render(board, results, out),
+  }
   for name, content in pages.items():
     storage.write_atomically(out / name, content)
   return [out / name for name in pages]
 
 
-__all__ = ["DEFAULT_OUT", "DEFAULT_RESULTS", "build", "ranking", "records", "text",
-           "write"]
+__all__ = ["DEFAULT_OUT", "DEFAULT_RESULTS", "build", "ranking", "records", "text", "write"]

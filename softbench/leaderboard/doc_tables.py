@@ -68,8 +68,9 @@ def _entries(board: ranking.Leaderboard) -> dict[tuple[Setting, str, str], ranki
 def _agents_in(names) -> list[str]:
   """``names`` in registry order, then any others by name."""
   names = set(names)
-  return ([agent for agent in agents.AGENTS if agent in names] +
-          sorted(names.difference(agents.AGENTS)))
+  return [agent for agent in agents.AGENTS if agent in names] + sorted(
+    names.difference(agents.AGENTS)
+  )
 
 
 def _with_paper(estimate, robot: str, task: str, agent: str) -> str:
@@ -82,46 +83,72 @@ def _with_paper(estimate, robot: str, task: str, agent: str) -> str:
 def _over_seeds(entry: ranking.Entry, metric: str, module: int) -> metrics.Statistic:
   """Mean and std over seeds of one module's (0-based) episode error (``ranking.mean_and_std``
   formats it like an ``Estimate``: it reads only ``mean`` and ``std``)."""
-  return metrics.Statistic.of([seed[metric]["per_module"][module]
-                               for seed in entry.record["per_seed"]])
+  return metrics.Statistic.of(
+    [seed[metric]["per_module"][module] for seed in entry.record["per_seed"]]
+  )
 
 
 def overview_table(setting: Setting) -> Callable[[ranking.Leaderboard], Table]:
   """The leaderboard's overview of ``setting``: agents by tasks, the paper's mean in brackets."""
+
   def table(board: ranking.Leaderboard) -> Table:
     for view in overview.overviews(board):
-      if (view.robot, view.profile, view.eval_mode) == (setting.robot, setting.profile,
-                                                        setting.eval_mode):
+      if (view.robot, view.profile, view.eval_mode) == (
+        setting.robot,
+        setting.profile,
+        setting.eval_mode,
+      ):
         return dataclasses.replace(view.table, caption=f"{setting}: {view.table.caption}")
     raise DocTableError(f"no records of {setting}")
+
   return table
 
 
 def modules_table(setting: Setting, task: str) -> Callable[[ranking.Leaderboard], Table]:
   """Per-module position error of every agent on one task, ranked as the leaderboard ranks."""
+
   def table(board: ranking.Leaderboard) -> Table:
-    ranked = [entry for group in board.groups  # Ranked already, best first.
-              if (group.robot, group.task, group.variant) == (setting.robot, task, "")
-              for entry in group.entries if entry.setting[1:] == (setting.profile,
-                                                                   setting.eval_mode)]
+    ranked = [
+      entry
+      for group in board.groups  # Ranked already, best first.
+      if (group.robot, group.task, group.variant) == (setting.robot, task, "")
+      for entry in group.entries
+      if entry.setting[1:] == (setting.profile, setting.eval_mode)
+    ]
     if not ranked:
       raise DocTableError(f"no records of {task} on {setting}")
     modules = len(ranked[0].record["per_seed"][0][METRIC]["per_module"])
-    rows = tuple((entry.record["agent"],
-                  *(ranking.mean_and_std(_over_seeds(entry, METRIC, module))
-                    for module in range(modules)),
-                  ranking.mean_and_std(entry.estimates[METRIC]),
-                  ranking.mean_and_std(entry.estimates[TIP_METRIC]),
-                  f"{entry.record['wall_time_s']:,.0f}") for entry in ranked)
-    return Table(f"{task} on {setting}: position error (mm) per module and averaged over "
-                 f"modules, normalised tip error (%), mean ± std over seeds; the record's wall "
-                 f"time (s)", ("agent", *(f"module {k + 1}" for k in range(modules)), "mean",
-                               "tip error (%)", "wall time (s)"), rows, label_columns=1)
+    rows = tuple(
+      (
+        entry.record["agent"],
+        *(ranking.mean_and_std(_over_seeds(entry, METRIC, module)) for module in range(modules)),
+        ranking.mean_and_std(entry.estimates[METRIC]),
+        ranking.mean_and_std(entry.estimates[TIP_METRIC]),
+        f"{entry.record['wall_time_s']:,.0f}",
+      )
+      for entry in ranked
+    )
+    return Table(
+      f"{task} on {setting}: position error (mm) per module and averaged over "
+      f"modules, normalised tip error (%), mean ± std over seeds; the record's wall "
+      f"time (s)",
+      (
+        "agent",
+        *(f"module {k + 1}" for k in range(modules)),
+        "mean",
+        "tip error (%)",
+        "wall time (s)",
+      ),
+      rows,
+      label_columns=1,
+    )
+
   return table
 
 
 def comparison_table(first: Setting, second: Setting) -> Callable[[ranking.Leaderboard], Table]:
   """Every agent's position error on ``first`` -> on ``second``, per task (``-``: no record)."""
+
   def table(board: ranking.Leaderboard) -> Table:
     found = _entries(board)
     shown = [(task, agent) for where, task, agent in found if where in (first, second)]
@@ -130,46 +157,89 @@ def comparison_table(first: Setting, second: Setting) -> Callable[[ranking.Leade
     def cell(where: Setting, task: str, agent: str) -> str:
       entry = found.get((where, task, agent))
       return "-" if entry is None else ranking.mean_and_std(entry.estimates[METRIC])
-    rows = tuple((agent, *(f"{cell(first, task, agent)} -> {cell(second, task, agent)}"
-                           for task in columns))
-                 for agent in _agents_in(agent for _, agent in shown))
-    return Table(f"position error (mm), mean ± std over seeds of the module-averaged error: "
-                 f"{first} -> {second}", ("agent", *columns), rows, label_columns=1)
+
+    rows = tuple(
+      (agent, *(f"{cell(first, task, agent)} -> {cell(second, task, agent)}" for task in columns))
+      for agent in _agents_in(agent for _, agent in shown)
+    )
+    return Table(
+      f"position error (mm), mean ± std over seeds of the module-averaged error: "
+      f"{first} -> {second}",
+      ("agent", *columns),
+      rows,
+      label_columns=1,
+    )
+
   return table
 
 
-def eval_modes_table(robot: str, task: str, profile: str,
-                     modes: tuple[str, ...]) -> Callable[[ranking.Leaderboard], Table]:
+def eval_modes_table(
+  robot: str, task: str, profile: str, modes: tuple[str, ...]
+) -> Callable[[ranking.Leaderboard], Table]:
   """Every agent's position error on one task under each eval mode (the error fed back)."""
+
   def table(board: ranking.Leaderboard) -> Table:
     found = _entries(board)
     settings = [Setting(robot, profile, mode) for mode in modes]
-    names = _agents_in(agent for where, on, agent in found if on == task and where in settings
-                       and where.eval_mode != "physics")
-    rows = tuple((agent, *("-" if (where, task, agent) not in found else
-                           ranking.mean_and_std(found[where, task, agent].estimates[METRIC])
-                           for where in settings)) for agent in names)
-    return Table(f"{task} on {robot}, {profile} profile: position error (mm), mean ± std over "
-                 f"seeds of the module-averaged error, by the error fed back (eval mode)",
-                 ("agent", *modes), rows, label_columns=1)
+    names = _agents_in(
+      agent
+      for where, on, agent in found
+      if on == task and where in settings and where.eval_mode != "physics"
+    )
+    rows = tuple(
+      (
+        agent,
+        *(
+          "-"
+          if (where, task, agent) not in found
+          else ranking.mean_and_std(found[where, task, agent].estimates[METRIC])
+          for where in settings
+        ),
+      )
+      for agent in names
+    )
+    return Table(
+      f"{task} on {robot}, {profile} profile: position error (mm), mean ± std over "
+      f"seeds of the module-averaged error, by the error fed back (eval mode)",
+      ("agent", *modes),
+      rows,
+      label_columns=1,
+    )
+
   return table
 
 
 def spiral_headline(settings: tuple[Setting, ...]) -> Callable[[ranking.Leaderboard], Table]:
   """Every agent on the spiral of several settings, the paper's mean in brackets."""
+
   def table(board: ranking.Leaderboard) -> Table:
     found = _entries(board)
-    names = _agents_in(agent for where, task, agent in found
-                       if task == "spiral" and where in settings)
-    rows = tuple((agent, *("-" if (where, "spiral", agent) not in found else
-                           _with_paper(found[where, "spiral", agent].estimates[METRIC],
-                                       where.robot, "spiral", agent) for where in settings))
-                 for agent in names)
-    return Table("spiral, closed loop in physics: position error (mm), mean ± std over seeds of "
-                 "the module-averaged error; in brackets the paper's mean (Exp2S for the tendon "
-                 "arms, Exp2R, the real robot, for pneumatic-433)",
-                 ("agent", *(f"{where.robot} {where.profile}" for where in settings)), rows,
-                 label_columns=1)
+    names = _agents_in(
+      agent for where, task, agent in found if task == "spiral" and where in settings
+    )
+    rows = tuple(
+      (
+        agent,
+        *(
+          "-"
+          if (where, "spiral", agent) not in found
+          else _with_paper(
+            found[where, "spiral", agent].estimates[METRIC], where.robot, "spiral", agent
+          )
+          for where in settings
+        ),
+      )
+      for agent in names
+    )
+    return Table(
+      "spiral, closed loop in physics: position error (mm), mean ± std over seeds of "
+      "the module-averaged error; in brackets the paper's mean (Exp2S for the tendon "
+      "arms, Exp2R, the real robot, for pneumatic-433)",
+      ("agent", *(f"{where.robot} {where.profile}" for where in settings)),
+      rows,
+      label_columns=1,
+    )
+
   return table
 
 
@@ -190,8 +260,9 @@ def _exp1s_paper_mean(robot: str, loop: str, task: str) -> float | None:
   return paper["scores"][loop][task][METRIC][paper["robots"].index(robot)][0]
 
 
-def _exp1s_figure(entry: exp1s_board.Entry, loop: str, task: str, index: int,
-                  metric: str = METRIC) -> str:
+def _exp1s_figure(
+  entry: exp1s_board.Entry, loop: str, task: str, index: int, metric: str = METRIC
+) -> str:
   """One configuration's (0-based) error, mean ± std over seeds, as the Exp1S section prints it."""
   statistic = entry.statistic(loop, task, index, metric)
   return exp1s_board.figure(statistic.mean, statistic.std)
@@ -206,56 +277,90 @@ def _exp1s_cell(entry: exp1s_board.Entry, loop: str, task: str, index: int) -> s
 def exp1s_table(family: str, profile: str) -> Callable[[ranking.Leaderboard], Table]:
   """Exp1S of one family and profile: the end effector's position error per configuration and
   task (closed loop, and open loop on the spiral), the paper's mean in brackets."""
+
   def table(board: ranking.Leaderboard) -> Table:
     entry = _exp1s_entry(board, family, profile)
     tasks = entry.record["tasks"]
-    rows = tuple((robot, *(_exp1s_cell(entry, "closed", task, index) for task in tasks),
-                  _exp1s_figure(entry, "closed", "spiral", index, TIP_METRIC),
-                  _exp1s_cell(entry, "open", "spiral", index))
-                 for index, robot in enumerate(entry.record["robots"]))
-    return Table(f"Exp1S, {family} family, {profile} profile, {entry.record['seeds']} seeds: "
-                 f"end-effector position error (mm), closed loop in physics unless said, mean ± "
-                 f"std over seeds; in brackets the paper's mean", (
-                     "configuration", *tasks, "tip error (%), spiral", "spiral, open loop"),
-                 rows, label_columns=1)
+    rows = tuple(
+      (
+        robot,
+        *(_exp1s_cell(entry, "closed", task, index) for task in tasks),
+        _exp1s_figure(entry, "closed", "spiral", index, TIP_METRIC),
+        _exp1s_cell(entry, "open", "spiral", index),
+      )
+      for index, robot in enumerate(entry.record["robots"])
+    )
+    return Table(
+      f"Exp1S, {family} family, {profile} profile, {entry.record['seeds']} seeds: "
+      f"end-effector position error (mm), closed loop in physics unless said, mean ± "
+      f"std over seeds; in brackets the paper's mean",
+      ("configuration", *tasks, "tip error (%), spiral", "spiral, open loop"),
+      rows,
+      label_columns=1,
+    )
+
   return table
 
 
-def exp1s_comparison_table(first: str, second: str,
-                           profile: str) -> Callable[[ranking.Leaderboard], Table]:
+def exp1s_comparison_table(
+  first: str, second: str, profile: str
+) -> Callable[[ranking.Leaderboard], Table]:
   """Exp1S closed-loop position error of two families' arms of as many modules side by side."""
+
   def table(board: ranking.Leaderboard) -> Table:
     entries = [_exp1s_entry(board, family, profile) for family in (first, second)]
     tasks = [task for task in entries[0].record["tasks"] if task in entries[1].record["tasks"]]
     sizes = min(len(entry.record["robots"]) for entry in entries)
-    rows = tuple((f"{index + 1} module{'s' if index else ''}",
-                  *(" -> ".join(_exp1s_figure(entry, "closed", task, index) for entry in entries)
-                    for task in tasks),
-                  " -> ".join(_exp1s_figure(entry, "closed", "spiral", index, TIP_METRIC)
-                              for entry in entries))
-                 for index in range(sizes))
-    return Table(f"Exp1S, {profile} profile, closed loop in physics: end-effector position error "
-                 f"(mm), mean ± std over seeds, {first}-N -> {second}-N",
-                 ("configuration", *tasks, "tip error (%), spiral"), rows, label_columns=1)
+    rows = tuple(
+      (
+        f"{index + 1} module{'s' if index else ''}",
+        *(
+          " -> ".join(_exp1s_figure(entry, "closed", task, index) for entry in entries)
+          for task in tasks
+        ),
+        " -> ".join(
+          _exp1s_figure(entry, "closed", "spiral", index, TIP_METRIC) for entry in entries
+        ),
+      )
+      for index in range(sizes)
+    )
+    return Table(
+      f"Exp1S, {profile} profile, closed loop in physics: end-effector position error "
+      f"(mm), mean ± std over seeds, {first}-N -> {second}-N",
+      ("configuration", *tasks, "tip error (%), spiral"),
+      rows,
+      label_columns=1,
+    )
+
   return table
 
 
-def exp1s_headline(settings: tuple[tuple[str, str], ...]
-                   ) -> Callable[[ranking.Leaderboard], Table]:
+def exp1s_headline(settings: tuple[tuple[str, str], ...]) -> Callable[[ranking.Leaderboard], Table]:
   """Exp1S spiral error per number of modules for several (family, profile), beside the paper."""
+
   def table(board: ranking.Leaderboard) -> Table:
     entries = [_exp1s_entry(board, *setting) for setting in settings]
     sizes = min(len(entry.record["robots"]) for entry in entries)
-    papers = [_exp1s_paper_mean(entries[0].record["robots"][index], "closed", "spiral")
-              for index in range(sizes)]
-    rows = tuple((str(index + 1),
-                  *(_exp1s_figure(entry, "closed", "spiral", index) for entry in entries),
-                  "-" if papers[index] is None else f"{papers[index]:.2f}")
-                 for index in range(sizes))
-    return Table("Exp1S spiral, closed loop in physics: end-effector position error (mm), mean ± "
-                 "std over seeds, per number of modules; the paper's mean last",
-                 ("modules", *(f"{family} {profile}" for family, profile in settings), "paper"),
-                 rows, label_columns=1)
+    papers = [
+      _exp1s_paper_mean(entries[0].record["robots"][index], "closed", "spiral")
+      for index in range(sizes)
+    ]
+    rows = tuple(
+      (
+        str(index + 1),
+        *(_exp1s_figure(entry, "closed", "spiral", index) for entry in entries),
+        "-" if papers[index] is None else f"{papers[index]:.2f}",
+      )
+      for index in range(sizes)
+    )
+    return Table(
+      "Exp1S spiral, closed loop in physics: end-effector position error (mm), mean ± "
+      "std over seeds, per number of modules; the paper's mean last",
+      ("modules", *(f"{family} {profile}" for family, profile in settings), "paper"),
+      rows,
+      label_columns=1,
+    )
+
   return table
 
 
@@ -266,29 +371,32 @@ TENDON_3_PAPER = Setting("tendon-3", "paper")
 PNEUMATIC_PAPER = Setting("pneumatic-433", "paper")
 
 TABLES: dict[str, Callable[[ranking.Leaderboard], Table]] = {
-    "headline-spiral": spiral_headline((TENDON_3, TENDON_3_PAPER, LOCAL_3, PNEUMATIC,
-                                        PNEUMATIC_PAPER)),
-    "headline-exp1s-spiral": exp1s_headline((("tendon", "default"), ("tendon", "paper"),
-                                             ("tendon-local", "default"))),
-    "overview-tendon-3-default": overview_table(TENDON_3),
-    "overview-tendon-3-paper": overview_table(TENDON_3_PAPER),
-    "overview-tendon-local-3-default": overview_table(LOCAL_3),
-    "overview-pneumatic-433-default": overview_table(PNEUMATIC),
-    "overview-pneumatic-433-paper": overview_table(PNEUMATIC_PAPER),
-    "modules-tendon-3-spiral-default": modules_table(TENDON_3, "spiral"),
-    "modules-tendon-3-spiral-paper": modules_table(TENDON_3_PAPER, "spiral"),
-    "modules-tendon-local-3-spiral-default": modules_table(LOCAL_3, "spiral"),
-    "modules-pneumatic-433-spiral-default": modules_table(PNEUMATIC, "spiral"),
-    "modules-pneumatic-433-spiral-paper": modules_table(PNEUMATIC_PAPER, "spiral"),
-    "profiles-tendon-3": comparison_table(TENDON_3, TENDON_3_PAPER),
-    "profiles-pneumatic-433": comparison_table(PNEUMATIC, PNEUMATIC_PAPER),
-    "plants-tendon-3-tendon-local-3": comparison_table(TENDON_3, LOCAL_3),
-    "eval-modes-tendon-3-spiral": eval_modes_table("tendon-3", "spiral", "default",
-                                                   ("physics", "model", "open-loop")),
-    "exp1s-tendon-default": exp1s_table("tendon", "default"),
-    "exp1s-tendon-paper": exp1s_table("tendon", "paper"),
-    "exp1s-tendon-local-default": exp1s_table("tendon-local", "default"),
-    "exp1s-families-default": exp1s_comparison_table("tendon", "tendon-local", "default"),
+  "headline-spiral": spiral_headline(
+    (TENDON_3, TENDON_3_PAPER, LOCAL_3, PNEUMATIC, PNEUMATIC_PAPER)
+  ),
+  "headline-exp1s-spiral": exp1s_headline(
+    (("tendon", "default"), ("tendon", "paper"), ("tendon-local", "default"))
+  ),
+  "overview-tendon-3-default": overview_table(TENDON_3),
+  "overview-tendon-3-paper": overview_table(TENDON_3_PAPER),
+  "overview-tendon-local-3-default": overview_table(LOCAL_3),
+  "overview-pneumatic-433-default": overview_table(PNEUMATIC),
+  "overview-pneumatic-433-paper": overview_table(PNEUMATIC_PAPER),
+  "modules-tendon-3-spiral-default": modules_table(TENDON_3, "spiral"),
+  "modules-tendon-3-spiral-paper": modules_table(TENDON_3_PAPER, "spiral"),
+  "modules-tendon-local-3-spiral-default": modules_table(LOCAL_3, "spiral"),
+  "modules-pneumatic-433-spiral-default": modules_table(PNEUMATIC, "spiral"),
+  "modules-pneumatic-433-spiral-paper": modules_table(PNEUMATIC_PAPER, "spiral"),
+  "profiles-tendon-3": comparison_table(TENDON_3, TENDON_3_PAPER),
+  "profiles-pneumatic-433": comparison_table(PNEUMATIC, PNEUMATIC_PAPER),
+  "plants-tendon-3-tendon-local-3": comparison_table(TENDON_3, LOCAL_3),
+  "eval-modes-tendon-3-spiral": eval_modes_table(
+    "tendon-3", "spiral", "default", ("physics", "model", "open-loop")
+  ),
+  "exp1s-tendon-default": exp1s_table("tendon", "default"),
+  "exp1s-tendon-paper": exp1s_table("tendon", "paper"),
+  "exp1s-tendon-local-default": exp1s_table("tendon-local", "default"),
+  "exp1s-families-default": exp1s_comparison_table("tendon", "tendon-local", "default"),
 }
 
 
@@ -322,8 +430,9 @@ def blocks(text: str, page: str = "page") -> list[Block]:
       if opened is not None:
         raise DocTableError(f"{page}:{number + 1}: table block inside block {opened[0]!r}")
       if start["name"] not in TABLES:
-        raise DocTableError(f"{page}:{number + 1}: unknown table {start['name']!r}; known: "
-                            f"{', '.join(TABLES)}")
+        raise DocTableError(
+          f"{page}:{number + 1}: unknown table {start['name']!r}; known: {', '.join(TABLES)}"
+        )
       opened = start["name"], number + 1
     elif line == END:
       if opened is None:
@@ -336,21 +445,22 @@ def blocks(text: str, page: str = "page") -> list[Block]:
 
 
 def _body(lines: list[str], block: Block) -> str:
-  return "".join(line + "\n" for line in lines[block.start:block.end])
+  return "".join(line + "\n" for line in lines[block.start : block.end])
 
 
 def stale_blocks(text: str, board: ranking.Leaderboard, page: str = "page") -> list[str]:
   """The names of the blocks of ``text`` that differ from what ``board`` generates."""
   lines = text.split("\n")
-  return [block.name for block in blocks(text, page)
-          if _body(lines, block) != render(block.name, board)]
+  return [
+    block.name for block in blocks(text, page) if _body(lines, block) != render(block.name, board)
+  ]
 
 
 def rewrite(text: str, board: ranking.Leaderboard, page: str = "page") -> str:
   """``text`` with every table block generated again from ``board``."""
   lines, parts, done = text.split("\n"), [], 0
   for block in blocks(text, page):
-    parts += lines[done:block.start] + render(block.name, board).split("\n")[:-1]
+    parts += lines[done : block.start] + render(block.name, board).split("\n")[:-1]
     done = block.end
   return "\n".join(parts + lines[done:])
 
@@ -379,5 +489,17 @@ def write(board: ranking.Leaderboard, results: pathlib.Path) -> list[pathlib.Pat
   return written
 
 
-__all__ = ["END", "START", "TABLES", "Block", "DocTableError", "Setting", "blocks", "pages",
-           "render", "rewrite", "stale_blocks", "write"]
+__all__ = [
+  "END",
+  "START",
+  "TABLES",
+  "Block",
+  "DocTableError",
+  "Setting",
+  "blocks",
+  "pages",
+  "render",
+  "rewrite",
+  "stale_blocks",
+  "write",
+]

@@ -28,8 +28,10 @@ from softbench.records import exp1s as exp1s_records
 PAPER_FILE = "paper_exp1s.json"  # In this package; its "source" names the paper's table.
 PAPER_METRICS = {"position_mm": "pos (mm)", "orientation_deg": "ori (deg)"}
 SOURCES = ("softbench", "paper")  # The two rows of each configuration.
-LOOP_LABELS = {"closed": "closed loop (softbench: error measured in physics)",
-               "open": "open loop (no error fed back)"}
+LOOP_LABELS = {
+  "closed": "closed loop (softbench: error measured in physics)",
+  "open": "open loop (no error fed back)",
+}
 
 
 def paper() -> dict:
@@ -63,19 +65,27 @@ class Entry:
   def label(self) -> str:
     return " / ".join(self.setting)
 
-  def statistic(self, loop: str, task: str, configuration: int,
-                metric: str) -> metrics.Statistic:
+  def statistic(self, loop: str, task: str, configuration: int, metric: str) -> metrics.Statistic:
     """Mean and std over seeds of one configuration's (0-based) error."""
-    return metrics.Statistic.of([seed["scores"][loop][task][configuration][metric]
-                                 for seed in self.record["per_seed"]])
+    return metrics.Statistic.of(
+      [seed["scores"][loop][task][configuration][metric] for seed in self.record["per_seed"]]
+    )
 
   def forgetting(self) -> list[list[float | None]]:
     """The forgetting matrix (stages x configurations, normalised tip %), mean over seeds;
     ``None`` above the diagonal."""
     size = len(self.record["robots"])
-    return [[metrics.Statistic.of([seed["forgetting_tip_percent"][stage][column]
-                                   for seed in self.record["per_seed"]]).mean
-             if column <= stage else None for column in range(size)] for stage in range(size)]
+    return [
+      [
+        metrics.Statistic.of(
+          [seed["forgetting_tip_percent"][stage][column] for seed in self.record["per_seed"]]
+        ).mean
+        if column <= stage
+        else None
+        for column in range(size)
+      ]
+      for stage in range(size)
+    ]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -89,8 +99,7 @@ class Group:
 
   @property
   def title(self) -> str:
-    return (f"Exp1S · {', '.join(self.robots)}" +
-            (f" ({self.variant})" if self.variant else ""))
+    return f"Exp1S · {', '.join(self.robots)}" + (f" ({self.variant})" if self.variant else "")
 
   @property
   def anchor(self) -> str:
@@ -103,8 +112,7 @@ def group(loaded: list[tuple[pathlib.Path, dict]]) -> tuple[Group, ...]:
   by_group: dict[tuple[tuple[str, ...], str], list[Entry]] = {}
   for path, record in loaded:
     if record["format"] == exp1s_records.FORMAT:
-      key = tuple(record["robots"]), ", ".join(f"with {name}"
-                                               for name in records.sections(record))
+      key = tuple(record["robots"]), ", ".join(f"with {name}" for name in records.sections(record))
       by_group.setdefault(key, []).append(Entry(pathlib.Path(path), record))
   groups = []
   for key in sorted(by_group, key=lambda k: (len(k[0]), k)):
@@ -125,42 +133,75 @@ def _paper_cells(robot: str, loop: str, task: str) -> list[str]:
 def loop_table(entry: Entry, loop: str) -> Table:
   """The paper's Exp1S layout for one loop: per configuration our row, then the paper's."""
   tasks = entry.record["tasks"]
-  header = ("config", "robot", "source",
-            *(f"{task} {label}" for task in tasks for label in PAPER_METRICS.values()))
+  header = (
+    "config",
+    "robot",
+    "source",
+    *(f"{task} {label}" for task in tasks for label in PAPER_METRICS.values()),
+  )
   rows = []
   for index, robot in enumerate(entry.record["robots"]):
-    ours = [_figure(entry.statistic(loop, task, index, metric))
-            for task in tasks for metric in PAPER_METRICS]
+    ours = [
+      _figure(entry.statistic(loop, task, index, metric))
+      for task in tasks
+      for metric in PAPER_METRICS
+    ]
     theirs = [cell for task in tasks for cell in _paper_cells(robot, loop, task)]
     rows += [(str(index + 1), robot, SOURCES[0], *ours), ("", "", SOURCES[1], *theirs)]
-  return Table(f"{LOOP_LABELS[loop]}: end-effector position (mm) and orientation (deg) error, "
-               f"mean ± std over seeds", header, tuple(rows), label_columns=3,
-               paper_rows=tuple(range(1, len(rows), len(SOURCES))))
+  return Table(
+    f"{LOOP_LABELS[loop]}: end-effector position (mm) and orientation (deg) error, "
+    f"mean ± std over seeds",
+    header,
+    tuple(rows),
+    label_columns=3,
+    paper_rows=tuple(range(1, len(rows), len(SOURCES))),
+  )
 
 
 def tip_table(entry: Entry) -> Table:
   """Normalised tip error (%) per configuration, task and loop, mean ± std over seeds."""
   tasks = entry.record["tasks"]
-  header = ("config", "robot",
-            *(f"{task} {loop}" for task in tasks for loop in exp1s_records.LOOPS))
-  rows = tuple((str(index + 1), robot,
-                *(_figure(entry.statistic(loop, task, index, "normalised_tip_percent"))
-                  for task in tasks for loop in exp1s_records.LOOPS))
-               for index, robot in enumerate(entry.record["robots"]))
-  return Table("normalised tip error (%): position error / robot length, mean ± std over seeds "
-               "(the paper gives no numbers for it)", header, rows, label_columns=2)
+  header = (
+    "config",
+    "robot",
+    *(f"{task} {loop}" for task in tasks for loop in exp1s_records.LOOPS),
+  )
+  rows = tuple(
+    (
+      str(index + 1),
+      robot,
+      *(
+        _figure(entry.statistic(loop, task, index, "normalised_tip_percent"))
+        for task in tasks
+        for loop in exp1s_records.LOOPS
+      ),
+    )
+    for index, robot in enumerate(entry.record["robots"])
+  )
+  return Table(
+    "normalised tip error (%): position error / robot length, mean ± std over seeds "
+    "(the paper gives no numbers for it)",
+    header,
+    rows,
+    label_columns=2,
+  )
 
 
 def forgetting_table(entry: Entry) -> Table:
   """The forgetting matrix as text: rows after each stage, columns per configuration."""
   robots = entry.record["robots"]
-  rows = tuple((f"{stage + 1}: {robots[stage]}",
-                *("" if value is None else f"{value:.2f}" for value in row))
-               for stage, row in enumerate(entry.forgetting()))
-  return Table(f"forgetting matrix: normalised tip error (%) on {exp1s_records.FORGETTING_TASK}, "
-               f"closed loop, of each configuration (columns) after each training stage (rows), "
-               f"mean over seeds (the paper shows it only as a figure)",
-               ("after stage", *robots), rows, label_columns=1)
+  rows = tuple(
+    (f"{stage + 1}: {robots[stage]}", *("" if value is None else f"{value:.2f}" for value in row))
+    for stage, row in enumerate(entry.forgetting())
+  )
+  return Table(
+    f"forgetting matrix: normalised tip error (%) on {exp1s_records.FORGETTING_TASK}, "
+    f"closed loop, of each configuration (columns) after each training stage (rows), "
+    f"mean over seeds (the paper shows it only as a figure)",
+    ("after stage", *robots),
+    rows,
+    label_columns=1,
+  )
 
 
 def score_tables(entry: Entry) -> tuple[Table, ...]:
@@ -175,18 +216,22 @@ def tables(entry: Entry) -> tuple[Table, ...]:
 
 def describe(entry: Entry) -> str:
   """One line on what the entry is: agent, profile, seeds and date."""
-  return (f"{entry.label}, {entry.record['seeds']} seed(s), {entry.record['date']}, end "
-          f"effector in physics")
+  return (
+    f"{entry.label}, {entry.record['seeds']} seed(s), {entry.record['date']}, end "
+    f"effector in physics"
+  )
 
 
 def explanation() -> str:
   """How to read the Exp1S sections, for each page's introduction."""
-  return ("Exp1S records (softbench run --protocol exp1s: SMPL learns tendon-1 .. tendon-5 in "
-          "sequence) have sections of their own in the paper's layout: per loop, configurations "
-          "by rows, per task the end effector's position (mm) and orientation (deg) error, mean "
-          "± std over seeds, each row followed by the paper's; the normalised tip error (%); and "
-          "the forgetting matrix (normalised tip error after each training stage, mean over "
-          "seeds). The newest record per agent and profile is shown.")
+  return (
+    "Exp1S records (softbench run --protocol exp1s: SMPL learns tendon-1 .. tendon-5 in "
+    "sequence) have sections of their own in the paper's layout: per loop, configurations "
+    "by rows, per task the end effector's position (mm) and orientation (deg) error, mean "
+    "± std over seeds, each row followed by the paper's; the normalised tip error (%); and "
+    "the forgetting matrix (normalised tip error after each training stage, mean over "
+    "seeds). The newest record per agent and profile is shown."
+  )
 
 
 def about_paper() -> str:

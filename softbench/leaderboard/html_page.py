@@ -99,46 +99,62 @@ def _chart(group: ranking.Group, metric: str) -> str:
   rows = [entry for entry in group.entries if metric in entry.estimates]
   bars_width = _CHART_WIDTH - _CHART_LABEL_WIDTH - _CHART_VALUE_WIDTH
   height = 2 * _CHART_PAD + _CHART_ROW_HEIGHT * len(rows)
-  highest = max(max([estimate.mean, *(estimate.interval or ())]) for estimate in
-                (entry.estimates[metric] for entry in rows))
+  highest = max(
+    max([estimate.mean, *(estimate.interval or ())])
+    for estimate in (entry.estimates[metric] for entry in rows)
+  )
   scale = bars_width / highest if highest > 0 else 0.0
   label = ranking.METRIC_LABELS[metric]
-  parts = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{_CHART_WIDTH}" height="{height}" '
-           f'viewBox="0 0 {_CHART_WIDTH} {height}" role="img" aria-label="{_e(label)}">']
+  parts = [
+    f'<svg xmlns="http://www.w3.org/2000/svg" width="{_CHART_WIDTH}" height="{height}" '
+    f'viewBox="0 0 {_CHART_WIDTH} {height}" role="img" aria-label="{_e(label)}">'
+  ]
   for index, entry in enumerate(rows):
     estimate = entry.estimates[metric]
     top = _CHART_PAD + index * _CHART_ROW_HEIGHT
     middle = top + _CHART_ROW_HEIGHT / 2
     bar_top = middle - _CHART_BAR_HEIGHT / 2
     parts.append(f"<g><title>{_e(entry.label)}: {_e(ranking.cell(estimate))}</title>")
-    parts.append(f'<text x="{_CHART_LABEL_WIDTH - 6}" y="{_px(middle + 4)}" '
-                 f'text-anchor="end">{_e(entry.label)}</text>')
-    parts.append(f'<rect class="bar" x="{_CHART_LABEL_WIDTH}" y="{_px(bar_top)}" '
-                 f'width="{_px(estimate.mean * scale)}" height="{_CHART_BAR_HEIGHT}"/>')
+    parts.append(
+      f'<text x="{_CHART_LABEL_WIDTH - 6}" y="{_px(middle + 4)}" '
+      f'text-anchor="end">{_e(entry.label)}</text>'
+    )
+    parts.append(
+      f'<rect class="bar" x="{_CHART_LABEL_WIDTH}" y="{_px(bar_top)}" '
+      f'width="{_px(estimate.mean * scale)}" height="{_CHART_BAR_HEIGHT}"/>'
+    )
     if estimate.interval is not None:
       low, high = (_CHART_LABEL_WIDTH + value * scale for value in estimate.interval)
-      parts.append(f'<path class="whisker" d="M{_px(low)} {_px(middle)}H{_px(high)}'
-                   f'M{_px(low)} {_px(middle - 4)}V{_px(middle + 4)}'
-                   f'M{_px(high)} {_px(middle - 4)}V{_px(middle + 4)}"/>')
-    parts.append(f'<text x="{_CHART_WIDTH - _CHART_VALUE_WIDTH + 6}" y="{_px(middle + 4)}">'
-                 f'{_e(ranking.number(estimate.mean))}</text></g>')
+      parts.append(
+        f'<path class="whisker" d="M{_px(low)} {_px(middle)}H{_px(high)}'
+        f"M{_px(low)} {_px(middle - 4)}V{_px(middle + 4)}"
+        f'M{_px(high)} {_px(middle - 4)}V{_px(middle + 4)}"/>'
+      )
+    parts.append(
+      f'<text x="{_CHART_WIDTH - _CHART_VALUE_WIDTH + 6}" y="{_px(middle + 4)}">'
+      f"{_e(ranking.number(estimate.mean))}</text></g>"
+    )
   parts.append("</svg>")
-  caption = (f"{label}, mean over seeds (lower is better); whiskers: "
-             f"{ranking.CONFIDENCE:.0%} bootstrap CI")
+  caption = (
+    f"{label}, mean over seeds (lower is better); whiskers: {ranking.CONFIDENCE:.0%} bootstrap CI"
+  )
   return f"<figure>{''.join(parts)}<figcaption>{_e(caption)}</figcaption></figure>"
 
 
 def _table(group: ranking.Group, out: pathlib.Path) -> str:
-  columns = ([("#", "number"), ("agent", "text"), ("profile", "text"), ("eval", "text"),
-              ("seeds", "number")] +
-             [(ranking.METRIC_LABELS[name], "number") for name in group.metrics] +
-             [("video", "text"), ("record", "text")])
+  columns = (
+    [("#", "number"), ("agent", "text"), ("profile", "text"), ("eval", "text"), ("seeds", "number")]
+    + [(ranking.METRIC_LABELS[name], "number") for name in group.metrics]
+    + [("video", "text"), ("record", "text")]
+  )
   head = "".join(f'<th scope="col" data-type="{kind}">{_e(name)}</th>' for name, kind in columns)
   body = []
   for place, entry in enumerate(group.entries, start=1):
-    cells = [f'<td class="number">{place}</td>',
-             *(f"<td>{_e(value)}</td>" for value in entry.shown_setting),
-             f'<td class="number">{entry.record["seeds"]}</td>']
+    cells = [
+      f'<td class="number">{place}</td>',
+      *(f"<td>{_e(value)}</td>" for value in entry.shown_setting),
+      f'<td class="number">{entry.record["seeds"]}</td>',
+    ]
     for name in group.metrics:
       estimate = entry.estimates.get(name)
       value = "" if estimate is None else repr(estimate.mean)
@@ -147,22 +163,30 @@ def _table(group: ranking.Group, out: pathlib.Path) -> str:
     cells.append(f'<td><a href="{_e(video)}">video</a></td>' if video else "<td>-</td>")
     cells.append(f'<td><a href="{_e(links.record(entry, out))}">{_e(entry.path.name)}</a></td>')
     body.append(f"<tr>{''.join(cells)}</tr>")
-  return (f'<table class="sortable"><thead><tr>{head}</tr></thead>'
-          f'<tbody>{"".join(body)}</tbody></table>')
+  return (
+    f'<table class="sortable"><thead><tr>{head}</tr></thead><tbody>{"".join(body)}</tbody></table>'
+  )
 
 
 def _superseded(entries, setting: str, out: pathlib.Path) -> str:
   """The note listing records superseded by a newer one of the same ``setting``."""
-  items = "".join(f'<li><a href="{_e(links.record(entry, out))}">{_e(entry.path.name)}</a> '
-                  f"({_e(entry.label)}, {_e(entry.record['date'])})</li>" for entry in entries)
-  return (f'<p class="note">Superseded by a newer record of the same {_e(setting)}:</p>'
-          f'<ul class="note">{items}</ul>')
+  items = "".join(
+    f'<li><a href="{_e(links.record(entry, out))}">{_e(entry.path.name)}</a> '
+    f"({_e(entry.label)}, {_e(entry.record['date'])})</li>"
+    for entry in entries
+  )
+  return (
+    f'<p class="note">Superseded by a newer record of the same {_e(setting)}:</p>'
+    f'<ul class="note">{items}</ul>'
+  )
 
 
 def _group(group: ranking.Group, out: pathlib.Path) -> str:
-  parts = [f'<section id="{_e(group.anchor)}"><h2>{_e(group.title)}</h2>', _table(group, out),
-           '<div class="charts">' + "".join(_chart(group, name) for name in group.metrics) +
-           "</div>"]
+  parts = [
+    f'<section id="{_e(group.anchor)}"><h2>{_e(group.title)}</h2>',
+    _table(group, out),
+    '<div class="charts">' + "".join(_chart(group, name) for name in group.metrics) + "</div>",
+  ]
   if group.superseded:
     parts.append(_superseded(group.superseded, "agent, profile and eval mode", out))
   parts.append("</section>")
@@ -173,12 +197,19 @@ def _figure_table(table: figure_table.Table) -> str:
   head = "".join(f'<th scope="col">{_e(name)}</th>' for name in table.header)
   body = []
   for index, row in enumerate(table.rows):
-    cells = "".join(f"<td>{_e(value)}</td>" if column < table.label_columns else
-                    f'<td class="figure">{_e(value)}</td>' for column, value in enumerate(row))
-    body.append(f'<tr class="paper">{cells}</tr>' if index in table.paper_rows else
-                f"<tr>{cells}</tr>")
-  return (f'<table class="figures"><caption>{_e(table.caption)}</caption><thead><tr>{head}</tr>'
-          f'</thead><tbody>{"".join(body)}</tbody></table>')
+    cells = "".join(
+      f"<td>{_e(value)}</td>"
+      if column < table.label_columns
+      else f'<td class="figure">{_e(value)}</td>'
+      for column, value in enumerate(row)
+    )
+    body.append(
+      f'<tr class="paper">{cells}</tr>' if index in table.paper_rows else f"<tr>{cells}</tr>"
+    )
+  return (
+    f'<table class="figures"><caption>{_e(table.caption)}</caption><thead><tr>{head}</tr>'
+    f"</thead><tbody>{''.join(body)}</tbody></table>"
+  )
 
 
 def _rgb(colour: tuple[float, ...]) -> str:
@@ -201,30 +232,43 @@ def _heat_map(entry: exp1s_board.Entry) -> str:
       share = value / highest if highest > 0 else 0.0
       colour = _rgb(tuple(low + share * (high - low) for low, high in zip(_HEAT_LOW, _HEAT_HIGH)))
       ink = "#ffffff" if share >= _HEAT_LIGHT_TEXT_FROM else "#1b1f24"
-      cells.append(f'<td class="figure" style="background:{colour};color:{ink}" '
-                   f'data-value="{value!r}">{_e(text)}</td>')
+      cells.append(
+        f'<td class="figure" style="background:{colour};color:{ink}" '
+        f'data-value="{value!r}">{_e(text)}</td>'
+      )
     body.append(f"<tr>{''.join(cells)}</tr>")
-  legend = (f'<p class="note">Colour: 0 % <span class="legend" style="background:linear-gradient('
-            f'to right,{_rgb(_HEAT_LOW)},{_rgb(_HEAT_HIGH)})"></span> '
-            f"{_e(ranking.number(highest))} % (the largest value).</p>")
-  return (f'<table class="figures heat"><caption>{_e(table.caption)}</caption><thead><tr>{head}'
-          f'</tr></thead><tbody>{"".join(body)}</tbody></table>{legend}')
+  legend = (
+    f'<p class="note">Colour: 0 % <span class="legend" style="background:linear-gradient('
+    f'to right,{_rgb(_HEAT_LOW)},{_rgb(_HEAT_HIGH)})"></span> '
+    f"{_e(ranking.number(highest))} % (the largest value).</p>"
+  )
+  return (
+    f'<table class="figures heat"><caption>{_e(table.caption)}</caption><thead><tr>{head}'
+    f"</tr></thead><tbody>{''.join(body)}</tbody></table>{legend}"
+  )
 
 
 def _overviews(views: tuple[overview.Overview, ...]) -> list[str]:
   if not views:
     return []
-  return [*(f'<section id="{_e(view.anchor)}"><h2>{_e(view.title)}</h2>'
-            f"{_figure_table(view.table)}</section>" for view in views),
-          f'<p class="note">{_e(overview.about_paper())}</p>']
+  return [
+    *(
+      f'<section id="{_e(view.anchor)}"><h2>{_e(view.title)}</h2>'
+      f"{_figure_table(view.table)}</section>"
+      for view in views
+    ),
+    f'<p class="note">{_e(overview.about_paper())}</p>',
+  ]
 
 
 def _exp1s_group(group: exp1s_board.Group, out: pathlib.Path) -> str:
   parts = [f'<section id="{_e(group.anchor)}"><h2>{_e(group.title)}</h2>']
   for entry in group.entries:
     parts.append(f"<h3>{_e(entry.label)}</h3>")
-    parts.append(f"<p>{_e(exp1s_board.describe(entry))}; record "
-                 f'<a href="{_e(links.record(entry, out))}">{_e(entry.path.name)}</a>.</p>')
+    parts.append(
+      f"<p>{_e(exp1s_board.describe(entry))}; record "
+      f'<a href="{_e(links.record(entry, out))}">{_e(entry.path.name)}</a>.</p>'
+    )
     parts += [_figure_table(table) for table in exp1s_board.score_tables(entry)]
     parts.append(_heat_map(entry))
   if group.superseded:
@@ -237,33 +281,56 @@ def render(board: ranking.Leaderboard, results: pathlib.Path, out: pathlib.Path)
   """The page, with links relative to the folder ``out`` it is written to."""
   results_link = links.relative(pathlib.Path(results), out)
   views = overview.overviews(board)
-  intro = [f'<p class="note">Generated by <code>softbench leaderboard --write</code> from the '
-           f'result records in <a href="{_e(results_link)}">{_e(results_link)}</a>.</p>']
+  intro = [
+    f'<p class="note">Generated by <code>softbench leaderboard --write</code> from the '
+    f'result records in <a href="{_e(results_link)}">{_e(results_link)}</a>.</p>'
+  ]
   if board.record_count:
     intro.append(
-        f"<p>{board.record_count} record(s), the newest from {_e(board.latest_date)}. Each row "
-        "is the newest record of one agent, profile and eval mode, ranked by position error "
-        "(lower is better; click a column to sort). Figures: mean ± standard deviation over "
-        "seeds of the episode's error averaged over the scored modules, "
-        f"[{ranking.CONFIDENCE:.0%} percentile bootstrap confidence interval of the mean, "
-        f"{ranking.BOOTSTRAP_RESAMPLES:,} resamples] with {ranking.MIN_SEEDS_FOR_INTERVAL} or "
-        "more seeds. How to submit an agent: the <em>Leaderboard</em> section of softbench's "
-        "README.</p>")
+      f"<p>{board.record_count} record(s), the newest from {_e(board.latest_date)}. Each row "
+      "is the newest record of one agent, profile and eval mode, ranked by position error "
+      "(lower is better; click a column to sort). Figures: mean ± standard deviation over "
+      "seeds of the episode's error averaged over the scored modules, "
+      f"[{ranking.CONFIDENCE:.0%} percentile bootstrap confidence interval of the mean, "
+      f"{ranking.BOOTSTRAP_RESAMPLES:,} resamples] with {ranking.MIN_SEEDS_FOR_INTERVAL} or "
+      "more seeds. How to submit an agent: the <em>Leaderboard</em> section of softbench's "
+      "README.</p>"
+    )
     if board.exp1s:
       intro.append(f"<p>{_e(exp1s_board.explanation())}</p>")
-    intro.append("<nav><ul>" + "".join(f'<li><a href="#{_e(group.anchor)}">{_e(group.title)}'
-                                        f"</a></li>"
-                                        for group in (*views, *board.groups, *board.exp1s)) +
-                  "</ul></nav>")
+    intro.append(
+      "<nav><ul>"
+      + "".join(
+        f'<li><a href="#{_e(group.anchor)}">{_e(group.title)}</a></li>'
+        for group in (*views, *board.groups, *board.exp1s)
+      )
+      + "</ul></nav>"
+    )
   else:
-    intro.append("<p>No result records yet. Make one with <code>softbench run</code> (for "
-                 "example <code>softbench run --task spiral --agent smpl</code>), then run "
-                 "<code>softbench leaderboard --write</code>.</p>")
-  return "\n".join([
-      "<!DOCTYPE html>", '<html lang="en">', "<head>", '<meta charset="utf-8">',
+    intro.append(
+      "<p>No result records yet. Make one with <code>softbench run</code> (for "
+      "example <code>softbench run --task spiral --agent smpl</code>), then run "
+      "<code>softbench leaderboard --write</code>.</p>"
+    )
+  return "\n".join(
+    [
+      "<!DOCTYPE html>",
+      '<html lang="en">',
+      "<head>",
+      '<meta charset="utf-8">',
       '<meta name="viewport" content="width=device-width, initial-scale=1">',
-      "<title>softbench leaderboard</title>", f"<style>{_STYLE}</style>", "</head>", "<body>",
-      "<h1>softbench leaderboard</h1>", *intro, *_overviews(views),
+      "<title>softbench leaderboard</title>",
+      f"<style>{_STYLE}</style>",
+      "</head>",
+      "<body>",
+      "<h1>softbench leaderboard</h1>",
+      *intro,
+      *_overviews(views),
       *(_group(group, out) for group in board.groups),
       *(_exp1s_group(group, out) for group in board.exp1s),
-      f"<script>{_SCRIPT}</script>", "</body>", "</html>", ""])
+      f"<script>{_SCRIPT}</script>",
+      "</body>",
+      "</html>",
+      "",
+    ]
+  )

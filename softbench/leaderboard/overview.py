@@ -73,28 +73,49 @@ def overviews(board: ranking.Leaderboard) -> tuple[Overview, ...]:
       continue
     for entry in group.entries:
       agent, profile, eval_mode = entry.setting
-      cells.setdefault((group.robot, profile, eval_mode), {})[agent, group.task] = (
-          entry.estimates[METRIC])
+      cells.setdefault((group.robot, profile, eval_mode), {})[agent, group.task] = entry.estimates[
+        METRIC
+      ]
   tables = []
   for (robot, profile, eval_mode), estimates in cells.items():  # Already in the groups' order.
     tasks = sorted({task for _, task in estimates}, key=suite.TASKS.index)
-    names = sorted({agent for agent, _ in estimates},
-                   key=lambda agent: _known_first(agent, agents.AGENTS))
+    names = sorted(
+      {agent for agent, _ in estimates}, key=lambda agent: _known_first(agent, agents.AGENTS)
+    )
     experiment = paper()["experiments"].get(paper_tables.paper_robot(robot))
-    caption = ("position error (mm), mean ± std over seeds of the module-averaged error; " +
-               (f"in brackets the paper's {experiment['name']} mean" if experiment else
-                "the paper has no table for this robot"))
+    caption = "position error (mm), mean ± std over seeds of the module-averaged error; " + (
+      f"in brackets the paper's {experiment['name']} mean"
+      if experiment
+      else "the paper has no table for this robot"
+    )
     missing = [agent for agent in agents.AGENTS if agent not in names]
     if missing:
       caption += f"; no record yet of {', '.join(missing)}"
-    rows = tuple((agent, *(_cell(estimates[agent, task], paper_mean(robot, task, agent))
-                           if (agent, task) in estimates else "-" for task in tasks))
-                 for agent in names)
-    tables.append(Overview(robot, profile, eval_mode,
-                           Table(caption, ("agent", *tasks), rows, label_columns=1)))
-  return tuple(sorted(tables, key=lambda view: (
-      ranking.robot_order(view.robot), _known_first(view.profile, profiles.PROFILES),
-      _known_first(view.eval_mode, record_fields.ERROR_SOURCES))))
+    rows = tuple(
+      (
+        agent,
+        *(
+          _cell(estimates[agent, task], paper_mean(robot, task, agent))
+          if (agent, task) in estimates
+          else "-"
+          for task in tasks
+        ),
+      )
+      for agent in names
+    )
+    tables.append(
+      Overview(robot, profile, eval_mode, Table(caption, ("agent", *tasks), rows, label_columns=1))
+    )
+  return tuple(
+    sorted(
+      tables,
+      key=lambda view: (
+        ranking.robot_order(view.robot),
+        _known_first(view.profile, profiles.PROFILES),
+        _known_first(view.eval_mode, record_fields.ERROR_SOURCES),
+      ),
+    )
+  )
 
 
 def about_paper() -> str:

@@ -29,8 +29,11 @@ BOOTSTRAP_RESAMPLES = 10_000
 BOOTSTRAP_SEED = 0  # Fixed: regenerating the leaderboard gives the same intervals.
 MIN_SEEDS_FOR_INTERVAL = 2
 RANKED_BY = "position_mm"
-METRIC_LABELS = {"position_mm": "position (mm)", "orientation_deg": "orientation (deg)",
-                 "normalised_tip_percent": "tip error (%)"}
+METRIC_LABELS = {
+  "position_mm": "position (mm)",
+  "orientation_deg": "orientation (deg)",
+  "normalised_tip_percent": "tip error (%)",
+}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -54,9 +57,16 @@ def _bootstrap_interval(values: np.ndarray) -> tuple[float, float] | None:
   if np.ptp(values) == 0:  # Every resample has the same mean; scipy would warn and give NaN.
     return float(values[0]), float(values[0])
   from scipy import stats  # Here: importing it takes 0.5 s, which softbench run need not pay.
-  result = stats.bootstrap((values,), np.mean, n_resamples=BOOTSTRAP_RESAMPLES,
-                           confidence_level=CONFIDENCE, method="percentile", vectorized=True,
-                           rng=np.random.default_rng(BOOTSTRAP_SEED))
+
+  result = stats.bootstrap(
+    (values,),
+    np.mean,
+    n_resamples=BOOTSTRAP_RESAMPLES,
+    confidence_level=CONFIDENCE,
+    method="percentile",
+    vectorized=True,
+    rng=np.random.default_rng(BOOTSTRAP_SEED),
+  )
   return float(result.confidence_interval.low), float(result.confidence_interval.high)
 
 
@@ -71,9 +81,11 @@ class Entry:
   @classmethod
   def of(cls, path: pathlib.Path, record: dict) -> "Entry":
     measured = [name for name in records.METRICS if name in record["per_seed"][0]]
-    return cls(pathlib.Path(path), record, {
-        name: Estimate.of([seed[name]["mean"] for seed in record["per_seed"]])
-        for name in measured})
+    return cls(
+      pathlib.Path(path),
+      record,
+      {name: Estimate.of([seed[name]["mean"] for seed in record["per_seed"]]) for name in measured},
+    )
 
   @property
   def setting(self) -> tuple[str, str, str]:
@@ -93,8 +105,13 @@ class Entry:
     if spent and all("environment_steps" in seed for seed in spent):
       steps = {seed["environment_steps"] for seed in spent}
       seconds = float(np.mean([seed["wall_time_s"] for seed in spent]))
-      took = (f"{seconds:.0f} s" if seconds < 60 else f"{seconds / 60:.0f} min"
-              if seconds < 7200 else f"{seconds / 3600:.1f} h")
+      took = (
+        f"{seconds:.0f} s"
+        if seconds < 60
+        else f"{seconds / 60:.0f} min"
+        if seconds < 7200
+        else f"{seconds / 3600:.1f} h"
+      )
       agent += f" ({'/'.join(f'{count:,}' for count in sorted(steps))} steps, {took} per seed)"
     return agent, profile, eval_mode
 
@@ -121,8 +138,9 @@ class Group:
   @property
   def metrics(self) -> tuple[str, ...]:
     """The metrics any row holds, in ``records.METRICS`` order."""
-    return tuple(name for name in records.METRICS
-                 if any(name in entry.estimates for entry in self.entries))
+    return tuple(
+      name for name in records.METRICS if any(name in entry.estimates for entry in self.entries)
+    )
 
 
 @dataclasses.dataclass(frozen=True)
@@ -151,8 +169,6 @@ def _moment(record: dict) -> datetime.datetime:
   return datetime.datetime.fromisoformat(record["date"])  # Checked, with a time zone.
 
 
-
-
 def rank(loaded: list[tuple[pathlib.Path, dict]]) -> Leaderboard:
   """The leaderboard of checked records (``records.read_folder``) of every kind."""
   by_group: dict[tuple[str, str, str], list[Entry]] = {}
@@ -163,12 +179,15 @@ def rank(loaded: list[tuple[pathlib.Path, dict]]) -> Leaderboard:
   groups = []
   for key in sorted(by_group, key=lambda k: (robot_order(k[0]), suite.TASKS.index(k[1]), k[2])):
     shown, superseded = selection.newest_per_setting(by_group[key])
-    ranked = sorted(shown,
-                    key=lambda entry: (entry.estimates[RANKED_BY].mean, entry.setting))
+    ranked = sorted(shown, key=lambda entry: (entry.estimates[RANKED_BY].mean, entry.setting))
     groups.append(Group(*key, tuple(ranked), tuple(superseded)))
   latest = max((record for _, record in loaded), key=_moment, default=None)
-  return Leaderboard(tuple(groups), len(loaded), None if latest is None else latest["date"],
-                     exp1s_board.group(loaded))
+  return Leaderboard(
+    tuple(groups),
+    len(loaded),
+    None if latest is None else latest["date"],
+    exp1s_board.group(loaded),
+  )
 
 
 def _decimals(value: float) -> int:

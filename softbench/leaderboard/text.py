@@ -14,9 +14,13 @@ _COLUMN_GAP = "  "
 
 def _aligned(rows: list[list[str]], right: set[int]) -> list[str]:
   widths = [max(len(row[k]) for row in rows) for k in range(len(rows[0]))]
-  return [_COLUMN_GAP.join(cell.rjust(width) if k in right else cell.ljust(width)
-                           for k, (cell, width) in enumerate(zip(row, widths))).rstrip()
-          for row in rows]
+  return [
+    _COLUMN_GAP.join(
+      cell.rjust(width) if k in right else cell.ljust(width)
+      for k, (cell, width) in enumerate(zip(row, widths))
+    ).rstrip()
+    for row in rows
+  ]
 
 
 def summary(board: ranking.Leaderboard, results: pathlib.Path) -> str:
@@ -24,16 +28,21 @@ def summary(board: ranking.Leaderboard, results: pathlib.Path) -> str:
   if not board.record_count:
     where = "no folder" if not pathlib.Path(results).exists() else "an empty folder"
     option = "" if pathlib.Path(results) == records.DEFAULT_FOLDER else f" --results {results}"
-    return (f"no result records in {results} ({where}); make one with softbench run, e.g. "
-            f"softbench run --task spiral --agent smpl{option}")
+    return (
+      f"no result records in {results} ({where}); make one with softbench run, e.g. "
+      f"softbench run --task spiral --agent smpl{option}"
+    )
   parts = [f"{board.record_count} result record(s) in {results}, newest {board.latest_date}"]
   if board.groups:
-    parts.append(f"one row per agent, profile and eval mode (its newest record), ranked by "
-                 f"position error; mean ± std over seeds [{ranking.CONFIDENCE:.0%} bootstrap CI "
-                 f"of the mean]")
+    parts.append(
+      f"one row per agent, profile and eval mode (its newest record), ranked by "
+      f"position error; mean ± std over seeds [{ranking.CONFIDENCE:.0%} bootstrap CI "
+      f"of the mean]"
+    )
   if board.exp1s:
-    parts.append("Exp1S: the newest record per agent and profile, in the paper's layout, "
-                 "mean ± std over seeds")
+    parts.append(
+      "Exp1S: the newest record per agent and profile, in the paper's layout, mean ± std over seeds"
+    )
   return "; ".join(parts)
 
 
@@ -43,12 +52,16 @@ def table(group: ranking.Group) -> str:
   header += [ranking.METRIC_LABELS[name] for name in group.metrics]
   rows = [header]
   for place, entry in enumerate(group.entries, start=1):
-    rows.append([str(place), *entry.shown_setting, str(entry.record["seeds"])] +
-                [ranking.cell(entry.estimates.get(name)) for name in group.metrics])
+    rows.append(
+      [str(place), *entry.shown_setting, str(entry.record["seeds"])]
+      + [ranking.cell(entry.estimates.get(name)) for name in group.metrics]
+    )
   lines = [group.title, *("  " + line for line in _aligned(rows, right={0, 4}))]
   for entry in group.superseded:
-    lines.append(f"  superseded: {entry.path.name} ({entry.label}, {entry.record['date']}, "
-                 f"position {ranking.cell(entry.estimates[ranking.RANKED_BY])} mm)")
+    lines.append(
+      f"  superseded: {entry.path.name} ({entry.label}, {entry.record['date']}, "
+      f"position {ranking.cell(entry.estimates[ranking.RANKED_BY])} mm)"
+    )
   return "\n".join(lines)
 
 
@@ -76,12 +89,19 @@ def overview_section(views: tuple[overview.Overview, ...]) -> list[str]:
   """Every overview (its title and table), then what the bracketed values are."""
   if not views:
     return []
-  return [*("\n".join([view.title, *figure_rows(view.table)]) for view in views),
-          overview.about_paper()]
+  return [
+    *("\n".join([view.title, *figure_rows(view.table)]) for view in views),
+    overview.about_paper(),
+  ]
 
 
 def report(board: ranking.Leaderboard, results: pathlib.Path) -> str:
   """The whole printout."""
-  return "\n\n".join([summary(board, results), *overview_section(overview.overviews(board)),
-                       *(table(group) for group in board.groups),
-                       *(exp1s_section(group) for group in board.exp1s)])
+  return "\n\n".join(
+    [
+      summary(board, results),
+      *overview_section(overview.overviews(board)),
+      *(table(group) for group in board.groups),
+      *(exp1s_section(group) for group in board.exp1s),
+    ]
+  )

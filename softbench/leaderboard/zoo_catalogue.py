@@ -25,12 +25,16 @@ class Setting:
 
   @property
   def label(self) -> str:
-    return (f"smpl {continual.PROTOCOL} on the {self.family} family" if self.family
-            else f"{self.agent} on {self.robot}") + f", profile {self.profile.name}"
+    return (
+      f"smpl {continual.PROTOCOL} on the {self.family} family"
+      if self.family
+      else f"{self.agent} on {self.robot}"
+    ) + f", profile {self.profile.name}"
 
 
-def setting(agent: str | None, robot: str | None, family: str | None, profile: str,
-            seeds: int | None) -> Setting:
+def setting(
+  agent: str | None, robot: str | None, family: str | None, profile: str, seeds: int | None
+) -> Setting:
   """A checked ``Setting``: ``agent`` (learned) with ``robot``, or ``family`` alone.
 
   Raises:
@@ -43,16 +47,21 @@ def setting(agent: str | None, robot: str | None, family: str | None, profile: s
     raise ValueError(f"seeds must be at least 1, got {seeds}")
   if family is not None:
     if agent not in (None, "smpl") or robot is not None:
-      raise ValueError(f"--protocol {continual.PROTOCOL} trains smpl on its family's arms; "
-                       "drop --robot")
+      raise ValueError(
+        f"--protocol {continual.PROTOCOL} trains smpl on its family's arms; drop --robot"
+      )
     continual.protocol(family)
     return Setting(chosen, seeds, family=family)
   if agent is None or robot is None:
-    raise ValueError("name the setting: --agent AGENT --robot ROBOT, or --protocol "
-                     f"{continual.PROTOCOL} [--family FAMILY]")
+    raise ValueError(
+      "name the setting: --agent AGENT --robot ROBOT, or --protocol "
+      f"{continual.PROTOCOL} [--family FAMILY]"
+    )
   if agents.learner(agent) is None:
-    raise ValueError(f"the zoo keeps the weights of agents trained on babbling "
-                     f"({', '.join(agents.babbling_learners())}), not of {agent!r}")
+    raise ValueError(
+      f"the zoo keeps the weights of agents trained on babbling "
+      f"({', '.join(agents.babbling_learners())}), not of {agent!r}"
+    )
   robots.make(robot)
   return Setting(chosen, seeds, agent=agent, robot=robot)
 
@@ -61,12 +70,18 @@ def cache_files(chosen: Setting) -> list[tuple[int, pathlib.Path, str]]:
   """(seed, cache file, zoo kind) of every file the setting's training writes to the data
   home: each seed's checkpoint, then (for an agent) its forward models."""
   if chosen.family is not None:
-    return [(seed, continual.checkpoint_path(seed, chosen.profile, chosen.family), "agent")
-            for seed in range(chosen.seeds)]
+    return [
+      (seed, continual.checkpoint_path(seed, chosen.profile, chosen.family), "agent")
+      for seed in range(chosen.seeds)
+    ]
   learner, arm = agents.learner(chosen.agent), robots.make(chosen.robot)
-  return [(seed, path, kind) for seed in range(chosen.seeds)
-          for path, kind in learned.cache_files(chosen.agent, arm, seed, chosen.profile,
-                                              learner.per_module)]
+  return [
+    (seed, path, kind)
+    for seed in range(chosen.seeds)
+    for path, kind in learned.cache_files(
+      chosen.agent, arm, seed, chosen.profile, learner.per_module
+    )
+  ]
 
 
 def stands_behind(record: dict, chosen: Setting, seed: int) -> bool:
@@ -74,14 +89,22 @@ def stands_behind(record: dict, chosen: Setting, seed: int) -> bool:
   if record["profile"] != chosen.profile.name or seed >= record["seeds"]:
     return False
   if chosen.family is not None:
-    return (record["format"] == continual.RECORD_FORMAT
-            and tuple(record["robots"]) == continual.protocol(chosen.family).robot_names)
-  return (record["format"] == records.FORMAT and record["agent"] == chosen.agent
-          and record["robot"] == chosen.robot and not record.get("faults"))
+    return (
+      record["format"] == continual.RECORD_FORMAT
+      and tuple(record["robots"]) == continual.protocol(chosen.family).robot_names
+    )
+  return (
+    record["format"] == records.FORMAT
+    and record["agent"] == chosen.agent
+    and record["robot"] == chosen.robot
+    and not record.get("faults")
+  )
 
 
 def records_of(chosen: Setting, results: pathlib.Path) -> dict[int, list[str]]:
   """The names of the records in ``results`` that each seed's weights stand behind."""
   found = records.read_folder(results)
-  return {seed: [path.name for path, record in found if stands_behind(record, chosen, seed)]
-          for seed in range(chosen.seeds)}
+  return {
+    seed: [path.name for path, record in found if stands_behind(record, chosen, seed)]
+    for seed in range(chosen.seeds)
+  }

@@ -1,6 +1,7 @@
 """``softbench zoo verify``: re-scores committed records from the zoo's weights alone, in an
 empty data home, and compares every figure with the record's."""
 
+from collections.abc import Iterator
 import contextlib
 import dataclasses
 import json
@@ -8,7 +9,6 @@ import os
 import pathlib
 import tempfile
 import time
-from collections.abc import Iterator
 
 from softbench import continual
 from softbench import profiles
@@ -51,8 +51,9 @@ def agent_of(entry: zoo.Entry) -> str:
   return entry.config.get("agent", "smpl")
 
 
-def planned(zoo_folder: pathlib.Path, agents: tuple[str, ...] | None, quick: bool
-            ) -> list[tuple[str, int]]:
+def planned(
+  zoo_folder: pathlib.Path, agents: tuple[str, ...] | None, quick: bool
+) -> list[tuple[str, int]]:
   """(record name, seed) pairs to re-score: every record each agent checkpoint of the zoo stands
   behind, for the agents named (all if None); ``quick``: seed 0 only, one record each."""
   pairs = []
@@ -71,15 +72,25 @@ def _rescored(record: dict, seed: int) -> dict:
   """Seed ``seed``'s entry of ``record`` computed again (in the current data home)."""
   profile = profiles.get(record["profile"])
   if record["format"] == continual.RECORD_FORMAT:
-    family = next(name for name in robots.TENDON_FAMILIES
-                  if continual.protocol(name).robot_names == tuple(record["robots"]))
+    family = next(
+      name
+      for name in robots.TENDON_FAMILIES
+      if continual.protocol(name).robot_names == tuple(record["robots"])
+    )
     with tempfile.TemporaryDirectory() as kept:
       entry = continual.score_seed(seed, profile, False, pathlib.Path(kept), family)
   else:
     module = record["scored_modules"][0] if record["task"] == "reach" else None
-    settings = run_module.settings(record["task"], record["agent"], record["robot"], 1,
-                                   record["profile"], record["eval_mode"], record["trajectory"],
-                                   module)
+    settings = run_module.settings(
+      record["task"],
+      record["agent"],
+      record["robot"],
+      1,
+      record["profile"],
+      record["eval_mode"],
+      record["trajectory"],
+      module,
+    )
     entry = run_module.score_seed(settings, seed)
   return json.loads(json.dumps(entry))  # As a record stores it.
 
@@ -93,8 +104,13 @@ def _difference(new: dict, old: dict) -> str:
   return f"differs in {', '.join(keys)}"
 
 
-def verify(results: pathlib.Path, zoo_folder: pathlib.Path, agents: tuple[str, ...] | None = None,
-           quick: bool = False, report=None) -> list[Check]:
+def verify(
+  results: pathlib.Path,
+  zoo_folder: pathlib.Path,
+  agents: tuple[str, ...] | None = None,
+  quick: bool = False,
+  report=None,
+) -> list[Check]:
   """Re-scores ``planned`` records in an empty data home, one seed at a time, and compares each
   seed's figures with the record's; ``report(check)`` sees each check as it ends."""
   found = {path.name: record for path, record in records.read_folder(results)}
@@ -102,16 +118,24 @@ def verify(results: pathlib.Path, zoo_folder: pathlib.Path, agents: tuple[str, .
   for name, seed in planned(zoo_folder, agents, quick):
     started = time.perf_counter()
     record = found.get(name)
-    stored = None if record is None else next(
-        (entry for entry in record["per_seed"] if entry["seed"] == seed), None)
+    stored = (
+      None
+      if record is None
+      else next((entry for entry in record["per_seed"] if entry["seed"] == seed), None)
+    )
     if stored is None:
       check = Check(name, seed, False, "no such record or seed in " + str(results), 0.0)
     else:
       with empty_data_home():
         new = _rescored(record, seed)
       identical = new == stored
-      check = Check(name, seed, identical, "" if identical else _difference(new, stored),
-                    time.perf_counter() - started)
+      check = Check(
+        name,
+        seed,
+        identical,
+        "" if identical else _difference(new, stored),
+        time.perf_counter() - started,
+      )
     checks.append(check)
     if report is not None:
       report(check)

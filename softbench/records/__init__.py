@@ -15,6 +15,7 @@ commands add to their records (a fault, an adaptive schedule); the hash covers t
 Version 1 records (before the hash) are refused: they cannot be checked.
 """
 
+from collections.abc import Callable
 import copy
 import dataclasses
 import hashlib
@@ -22,7 +23,6 @@ import json
 import math
 import os
 import pathlib
-from collections.abc import Callable
 
 import jsonschema
 from jsonschema import exceptions as schema_exceptions
@@ -55,58 +55,93 @@ def schema() -> dict:
   registries."""
   non_negative = record_fields.non_negative()
   per_module = {"type": "array", "items": non_negative, "minItems": 1}
-  metric = {"type": "object", "additionalProperties": False,
-            "required": ["per_module", "per_module_std_over_steps", "mean"],
-            "properties": {"per_module": per_module, "per_module_std_over_steps": per_module,
-                           "mean": non_negative}}
+  metric = {
+    "type": "object",
+    "additionalProperties": False,
+    "required": ["per_module", "per_module_std_over_steps", "mean"],
+    "properties": {
+      "per_module": per_module,
+      "per_module_std_over_steps": per_module,
+      "mean": non_negative,
+    },
+  }
   section = record_fields.section()
   seed = {
-      "type": "object",
-      "required": ["seed", "steps", "mean_reward", "position_mm", "normalised_tip_percent"],
-      "properties": {"seed": {"type": "integer", "minimum": 0},
-                     "steps": {"type": "integer", "minimum": 1},
-                     "mean_reward": {"type": "number", "minimum": 0, "maximum": 1},
-                     **{name: metric for name in METRICS}},
-      "additionalProperties": section,
+    "type": "object",
+    "required": ["seed", "steps", "mean_reward", "position_mm", "normalised_tip_percent"],
+    "properties": {
+      "seed": {"type": "integer", "minimum": 0},
+      "steps": {"type": "integer", "minimum": 1},
+      "mean_reward": {"type": "number", "minimum": 0, "maximum": 1},
+      **{name: metric for name in METRICS},
+    },
+    "additionalProperties": section,
   }
   properties = {
-      "format": {"const": FORMAT},
-      "version": {"const": VERSION},
-      "robot": {"type": "string", "pattern": record_fields.ROBOT_PATTERN},
-      "task": {"enum": list(suite.TASKS)},
-      "eval_mode": {"enum": list(record_fields.ERROR_SOURCES)},
-      "trajectory": {"type": ["string", "null"]},
-      "scored_modules": {"type": "array", "items": {"type": "integer", "minimum": 1},
-                         "minItems": 1, "uniqueItems": True},
-      "per_seed": {"type": "array", "items": seed},  # Empty in adaptive activation records.
-      "video": {"type": "string", "minLength": 1},
-      "faults": {"type": "array", "items": {  # softbench.robots.faults.describe
-          "type": "object", "required": ["module", "actuator", "gain", "text"],
-          "properties": {"module": {"type": "integer", "minimum": 1},
-                         "actuator": {"type": "integer", "minimum": 0},
-                         "gain": {"type": "number", "minimum": 0, "maximum": 1},
-                         "text": {"type": "string"}}}},
-      # The zoo files a run took instead of training (softbench.zoo.section).
-      "zoo": {"type": "object", "required": ["files"], "properties": {"files": {
-          "type": "array", "items": {"type": "string", "minLength": 1}, "minItems": 1}}},
-      # What an agent that learns by acting spent per seed (softbench.agents.training_summary).
-      "training": {"type": "object", "required": ["per_seed"], "properties": {"per_seed": {
-          "type": "array", "items": {
-              "type": "object", "required": ["seed"],
-              "properties": {"seed": {"type": "integer", "minimum": 0},
-                             "environment_steps": {"type": "integer", "minimum": 1},
-                             "episodes": {"type": "integer", "minimum": 1},
-                             "wall_time_s": record_fields.non_negative(
-                                 record_fields.MAX_WALL_TIME_S)}}}}},
-      **record_fields.properties(),
+    "format": {"const": FORMAT},
+    "version": {"const": VERSION},
+    "robot": {"type": "string", "pattern": record_fields.ROBOT_PATTERN},
+    "task": {"enum": list(suite.TASKS)},
+    "eval_mode": {"enum": list(record_fields.ERROR_SOURCES)},
+    "trajectory": {"type": ["string", "null"]},
+    "scored_modules": {
+      "type": "array",
+      "items": {"type": "integer", "minimum": 1},
+      "minItems": 1,
+      "uniqueItems": True,
+    },
+    "per_seed": {"type": "array", "items": seed},  # Empty in adaptive activation records.
+    "video": {"type": "string", "minLength": 1},
+    "faults": {
+      "type": "array",
+      "items": {  # softbench.robots.faults.describe
+        "type": "object",
+        "required": ["module", "actuator", "gain", "text"],
+        "properties": {
+          "module": {"type": "integer", "minimum": 1},
+          "actuator": {"type": "integer", "minimum": 0},
+          "gain": {"type": "number", "minimum": 0, "maximum": 1},
+          "text": {"type": "string"},
+        },
+      },
+    },
+    # The zoo files a run took instead of training (softbench.zoo.section).
+    "zoo": {
+      "type": "object",
+      "required": ["files"],
+      "properties": {
+        "files": {"type": "array", "items": {"type": "string", "minLength": 1}, "minItems": 1}
+      },
+    },
+    # What an agent that learns by acting spent per seed (softbench.agents.training_summary).
+    "training": {
+      "type": "object",
+      "required": ["per_seed"],
+      "properties": {
+        "per_seed": {
+          "type": "array",
+          "items": {
+            "type": "object",
+            "required": ["seed"],
+            "properties": {
+              "seed": {"type": "integer", "minimum": 0},
+              "environment_steps": {"type": "integer", "minimum": 1},
+              "episodes": {"type": "integer", "minimum": 1},
+              "wall_time_s": record_fields.non_negative(record_fields.MAX_WALL_TIME_S),
+            },
+          },
+        }
+      },
+    },
+    **record_fields.properties(),
   }
   return {
-      "$schema": "https://json-schema.org/draft/2020-12/schema",
-      "title": "softbench result record",
-      "type": "object",
-      "required": [name for name in properties if name not in _OPTIONAL_FIELDS],
-      "properties": properties,
-      "additionalProperties": section,
+    "$schema": "https://json-schema.org/draft/2020-12/schema",
+    "title": "softbench result record",
+    "type": "object",
+    "required": [name for name in properties if name not in _OPTIONAL_FIELDS],
+    "properties": properties,
+    "additionalProperties": section,
   }
 
 
@@ -122,9 +157,12 @@ class Kind:
 
 def kinds() -> dict[str, Kind]:
   """Every kind of record, by format."""
-  return {FORMAT: Kind(FORMAT, VERSION, schema, _check_consistency),
-          exp1s_records.FORMAT: Kind(exp1s_records.FORMAT, exp1s_records.VERSION,
-                                     exp1s_records.schema, exp1s_records.check)}
+  return {
+    FORMAT: Kind(FORMAT, VERSION, schema, _check_consistency),
+    exp1s_records.FORMAT: Kind(
+      exp1s_records.FORMAT, exp1s_records.VERSION, exp1s_records.schema, exp1s_records.check
+    ),
+  }
 
 
 def sections(record: dict) -> tuple[str, ...]:
@@ -135,8 +173,9 @@ def sections(record: dict) -> tuple[str, ...]:
 def content_sha256(record: dict) -> str:
   """The sha256 of the canonical JSON (sorted keys, no spaces) of the record without its hash."""
   content = {name: value for name, value in record.items() if name != INTEGRITY_FIELD}
-  canonical = json.dumps(content, sort_keys=True, separators=(",", ":"), ensure_ascii=False,
-                         allow_nan=False)
+  canonical = json.dumps(
+    content, sort_keys=True, separators=(",", ":"), ensure_ascii=False, allow_nan=False
+  )
   return hashlib.sha256(canonical.encode("utf-8")).hexdigest()
 
 
@@ -146,8 +185,7 @@ def seal(record: dict) -> dict:
   Raises:
     RecordError: the record does not match the schema or contradicts itself (one line).
   """
-  sealed = copy.deepcopy({name: value for name, value in record.items()
-                          if name != INTEGRITY_FIELD})
+  sealed = copy.deepcopy({name: value for name, value in record.items() if name != INTEGRITY_FIELD})
   check_finite(sealed, "record")
   sealed[INTEGRITY_FIELD] = content_sha256(sealed)
   validate(sealed, "record")
@@ -180,16 +218,18 @@ def read(path: pathlib.Path) -> dict:
     validate(record, str(path))
   except FileNotFoundError:
     if path.is_symlink():
-      raise RecordError(f"{path}: a broken link (to {os.readlink(path)}, which does not "
-                        f"exist)") from None
+      raise RecordError(
+        f"{path}: a broken link (to {os.readlink(path)}, which does not exist)"
+      ) from None
     raise
   except OSError as error:
     raise RecordError(f"{path}: cannot be read ({error.strerror})") from None
   except UnicodeDecodeError as error:
     raise RecordError(f"{path}: not UTF-8 text ({error.reason})") from None
   except json.JSONDecodeError as error:
-    raise RecordError(f"{path}: not valid JSON ({error.msg} at line {error.lineno}, "
-                      f"column {error.colno})") from None
+    raise RecordError(
+      f"{path}: not valid JSON ({error.msg} at line {error.lineno}, column {error.colno})"
+    ) from None
   except RecursionError:
     raise RecordError(f"{path}: not a result record (nested too deeply)") from None
   except RecordError:
@@ -217,8 +257,9 @@ def read_folder(folder: pathlib.Path) -> list[tuple[pathlib.Path, dict]]:
   except NotADirectoryError:
     raise RecordError(f"{folder}: not a folder of result records") from None
   except OSError as error:
-    raise RecordError(f"{folder}: the folder of result records cannot be read "
-                      f"({error.strerror})") from None
+    raise RecordError(
+      f"{folder}: the folder of result records cannot be read ({error.strerror})"
+    ) from None
   return [(folder / name, read(folder / name)) for name in names]
 
 
@@ -234,22 +275,29 @@ def validate(record: object, source: str) -> None:
   found = record.get("format")
   kind = known.get(found) if isinstance(found, str) else None
   if kind is None:
-    raise RecordError(f"{source}: not a result record (format {_shortened(repr(found))}, "
-                      f"expected one of {', '.join(map(repr, known))})")
+    raise RecordError(
+      f"{source}: not a result record (format {_shortened(repr(found))}, "
+      f"expected one of {', '.join(map(repr, known))})"
+    )
   version = record.get("version")
   if version != kind.version:
-    why = ("it has no integrity hash, so it cannot be checked; run it again"
-           if isinstance(version, int) and version < kind.version else
-           f"this softbench reads version {kind.version}")
+    why = (
+      "it has no integrity hash, so it cannot be checked; run it again"
+      if isinstance(version, int) and version < kind.version
+      else f"this softbench reads version {kind.version}"
+    )
     raise RecordError(f"{source}: record version {_shortened(repr(version))} is not read: {why}")
   check_finite(record, source)
   error = schema_exceptions.best_match(
-      jsonschema.Draft202012Validator(kind.schema()).iter_errors(record))
+    jsonschema.Draft202012Validator(kind.schema()).iter_errors(record)
+  )
   if error is not None:
     raise RecordError(f"{source}: {_describe(error)}")
   if record[INTEGRITY_FIELD] != content_sha256(record):
-    raise RecordError(f"{source}: content does not match its {INTEGRITY_FIELD} (edited after "
-                      f"softbench run wrote it?); records must not be edited by hand")
+    raise RecordError(
+      f"{source}: content does not match its {INTEGRITY_FIELD} (edited after "
+      f"softbench run wrote it?); records must not be edited by hand"
+    )
 
   def refuse(message: str) -> None:
     raise RecordError(f"{source}: {message}")
@@ -276,11 +324,13 @@ def _shortened(message: str) -> str:
 def _describe(error: schema_exceptions.ValidationError) -> str:
   where = _where(error.absolute_path)
   extra = error.validator == "additionalProperties" or (
-      list(error.schema_path)[-2:] == ["additionalProperties", "type"]
-      and error.validator_value == "object")  # An extra field that is not a section.
+    list(error.schema_path)[-2:] == ["additionalProperties", "type"]
+    and error.validator_value == "object"
+  )  # An extra field that is not a section.
   if extra:
-    return _shortened(f"{where}: unknown field (extra fields must be sections, JSON objects): "
-                      f"{error.message}")
+    return _shortened(
+      f"{where}: unknown field (extra fields must be sections, JSON objects): {error.message}"
+    )
   return f"{where}: {_shortened(error.message)}"
 
 
@@ -302,8 +352,7 @@ def _check_consistency(record: dict, refuse: record_fields.Refuse) -> None:
   follow."""
   adaptive = ADAPTIVE_SECTION in record
   if adaptive and record["per_seed"]:
-    refuse(f"an {ADAPTIVE_SECTION} record holds its scores in that section; per_seed must be "
-           f"empty")
+    refuse(f"an {ADAPTIVE_SECTION} record holds its scores in that section; per_seed must be empty")
   record_fields.check(record, refuse, seed_entries=0 if adaptive else None)
   per_seed = record["per_seed"]
   try:
@@ -311,23 +360,32 @@ def _check_consistency(record: dict, refuse: record_fields.Refuse) -> None:
   except ValueError as error:
     refuse(f"robot: {error}")
   if max(record["scored_modules"]) > num_modules:
-    refuse(f"scored_modules {record['scored_modules']} name a module beyond {record['robot']}'s "
-           f"{num_modules}")
+    refuse(
+      f"scored_modules {record['scored_modules']} name a module beyond {record['robot']}'s "
+      f"{num_modules}"
+    )
   if (record["trajectory"] is None) == (record["task"] == "custom"):
     refuse("trajectory goes with task custom, and task custom needs one")
   measured = [name for name in METRICS if per_seed and name in per_seed[0]]
   for index, entry in enumerate(per_seed):
     if [name for name in METRICS if name in entry] != measured:
-      refuse(f"per_seed[{index}] has metrics {[n for n in METRICS if n in entry]}, per_seed[0] "
-             f"has {measured}")
+      refuse(
+        f"per_seed[{index}] has metrics {[n for n in METRICS if n in entry]}, per_seed[0] "
+        f"has {measured}"
+      )
     for name in measured:
       where = f"per_seed[{index}].{name}"
       for field in ("per_module", "per_module_std_over_steps"):
         if len(entry[name][field]) != len(record["scored_modules"]):
-          refuse(f"{where}.{field} has {len(entry[name][field])} values for "
-                 f"{len(record['scored_modules'])} scored modules")
+          refuse(
+            f"{where}.{field} has {len(entry[name][field])} values for "
+            f"{len(record['scored_modules'])} scored modules"
+          )
       expected = math.fsum(entry[name]["per_module"]) / len(entry[name]["per_module"])
-      if not math.isclose(entry[name]["mean"], expected, rel_tol=_MEAN_TOLERANCE,
-                          abs_tol=_MEAN_TOLERANCE):
-        refuse(f"{where}.mean {entry[name]['mean']} is not the mean of its per_module values "
-               f"({expected})")
+      if not math.isclose(
+        entry[name]["mean"], expected, rel_tol=_MEAN_TOLERANCE, abs_tol=_MEAN_TOLERANCE
+      ):
+        refuse(
+          f"{where}.mean {entry[name]['mean']} is not the mean of its per_module values "
+          f"({expected})"
+        )

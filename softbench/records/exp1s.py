@@ -29,41 +29,58 @@ _TIP_TOLERANCE = 1e-9  # Relative: normalised tip error against position error /
 def schema() -> dict:
   """The JSON Schema (draft 2020-12) of an Exp1S record."""
   non_negative = record_fields.non_negative()
-  configuration = {"type": "object", "additionalProperties": False,
-                   "required": list(METRICS),
-                   "properties": {name: non_negative for name in METRICS}}
-  per_task = {"type": "object", "propertyNames": {"enum": list(TASKS)},
-              "additionalProperties": {"type": "array", "items": configuration, "minItems": 1}}
-  matrix = {"type": "array", "minItems": 1,
-            "items": {"type": "array", "items": {"anyOf": [non_negative, {"type": "null"}]}}}
+  configuration = {
+    "type": "object",
+    "additionalProperties": False,
+    "required": list(METRICS),
+    "properties": {name: non_negative for name in METRICS},
+  }
+  per_task = {
+    "type": "object",
+    "propertyNames": {"enum": list(TASKS)},
+    "additionalProperties": {"type": "array", "items": configuration, "minItems": 1},
+  }
+  matrix = {
+    "type": "array",
+    "minItems": 1,
+    "items": {"type": "array", "items": {"anyOf": [non_negative, {"type": "null"}]}},
+  }
   seed = {
-      "type": "object",
-      "required": ["seed", "scores", *MATRICES],
-      "properties": {"seed": {"type": "integer", "minimum": 0},
-                     "scores": {"type": "object", "additionalProperties": False,
-                                "required": list(LOOPS),
-                                "properties": {loop: per_task for loop in LOOPS}},
-                     **{name: matrix for name in MATRICES}},
-      "additionalProperties": record_fields.section(),
+    "type": "object",
+    "required": ["seed", "scores", *MATRICES],
+    "properties": {
+      "seed": {"type": "integer", "minimum": 0},
+      "scores": {
+        "type": "object",
+        "additionalProperties": False,
+        "required": list(LOOPS),
+        "properties": {loop: per_task for loop in LOOPS},
+      },
+      **{name: matrix for name in MATRICES},
+    },
+    "additionalProperties": record_fields.section(),
   }
   properties = {
-      "format": {"const": FORMAT},
-      "version": {"const": VERSION},
-      "protocol": {"const": PROTOCOL},
-      "robots": {"type": "array", "minItems": 1, "uniqueItems": True,
-                 "items": {"type": "string", "pattern": record_fields.ROBOT_PATTERN}},
-      "tasks": {"type": "array", "minItems": 1, "uniqueItems": True,
-                "items": {"enum": list(TASKS)}},
-      "per_seed": {"type": "array", "items": seed, "minItems": 1},
-      **record_fields.properties(),
+    "format": {"const": FORMAT},
+    "version": {"const": VERSION},
+    "protocol": {"const": PROTOCOL},
+    "robots": {
+      "type": "array",
+      "minItems": 1,
+      "uniqueItems": True,
+      "items": {"type": "string", "pattern": record_fields.ROBOT_PATTERN},
+    },
+    "tasks": {"type": "array", "minItems": 1, "uniqueItems": True, "items": {"enum": list(TASKS)}},
+    "per_seed": {"type": "array", "items": seed, "minItems": 1},
+    **record_fields.properties(),
   }
   return {
-      "$schema": "https://json-schema.org/draft/2020-12/schema",
-      "title": "softbench Exp1S result record",
-      "type": "object",
-      "required": list(properties),
-      "properties": properties,
-      "additionalProperties": record_fields.section(),
+    "$schema": "https://json-schema.org/draft/2020-12/schema",
+    "title": "softbench Exp1S result record",
+    "type": "object",
+    "required": list(properties),
+    "properties": properties,
+    "additionalProperties": record_fields.section(),
   }
 
 
@@ -78,37 +95,47 @@ def check(record: dict, refuse: record_fields.Refuse) -> None:
     except ValueError as error:
       refuse(f"robots: {error}")
   if FORGETTING_TASK not in record["tasks"]:
-    refuse(f"tasks {record['tasks']} lack {FORGETTING_TASK}, the task of the "
-           f"forgetting matrix")
+    refuse(f"tasks {record['tasks']} lack {FORGETTING_TASK}, the task of the forgetting matrix")
   for index, entry in enumerate(record["per_seed"]):
     _check_scores(record, entry["scores"], f"per_seed[{index}].scores", lengths_mm, refuse)
     for name in MATRICES:
       _check_triangular(entry[name], len(record["robots"]), f"per_seed[{index}].{name}", refuse)
-    closed = [scores["normalised_tip_percent"]
-              for scores in entry["scores"]["closed"][FORGETTING_TASK]]
+    closed = [
+      scores["normalised_tip_percent"] for scores in entry["scores"]["closed"][FORGETTING_TASK]
+    ]
     if entry["forgetting_tip_percent"][-1] != closed:
-      refuse(f"per_seed[{index}].forgetting_tip_percent's last row "
-             f"{entry['forgetting_tip_percent'][-1]} is not the closed-loop "
-             f"{FORGETTING_TASK} normalised tip errors {closed}")
+      refuse(
+        f"per_seed[{index}].forgetting_tip_percent's last row "
+        f"{entry['forgetting_tip_percent'][-1]} is not the closed-loop "
+        f"{FORGETTING_TASK} normalised tip errors {closed}"
+      )
 
 
-def _check_scores(record: dict, scores: dict, where: str, lengths_mm: dict,
-                  refuse: record_fields.Refuse) -> None:
+def _check_scores(
+  record: dict, scores: dict, where: str, lengths_mm: dict, refuse: record_fields.Refuse
+) -> None:
   for loop, per_task in scores.items():
     if sorted(per_task) != sorted(record["tasks"]):
-      refuse(f"{where}.{loop} has tasks {sorted(per_task)}, the record's tasks are "
-             f"{sorted(record['tasks'])}")
+      refuse(
+        f"{where}.{loop} has tasks {sorted(per_task)}, the record's tasks are "
+        f"{sorted(record['tasks'])}"
+      )
     for task, entries in per_task.items():
       if len(entries) != len(record["robots"]):
-        refuse(f"{where}.{loop}.{task} has {len(entries)} entries for "
-               f"{len(record['robots'])} configurations")
+        refuse(
+          f"{where}.{loop}.{task} has {len(entries)} entries for "
+          f"{len(record['robots'])} configurations"
+        )
       for configuration, (robot, entry) in enumerate(zip(record["robots"], entries)):
         expected = entry["position_mm"] / lengths_mm[robot] * metrics.PERCENT
-        if not math.isclose(entry["normalised_tip_percent"], expected, rel_tol=_TIP_TOLERANCE,
-                            abs_tol=_TIP_TOLERANCE):
-          refuse(f"{where}.{loop}.{task}[{configuration}]: "
-                 f"normalised_tip_percent {entry['normalised_tip_percent']} is not "
-                 f"position_mm / {robot}'s length ({expected})")
+        if not math.isclose(
+          entry["normalised_tip_percent"], expected, rel_tol=_TIP_TOLERANCE, abs_tol=_TIP_TOLERANCE
+        ):
+          refuse(
+            f"{where}.{loop}.{task}[{configuration}]: "
+            f"normalised_tip_percent {entry['normalised_tip_percent']} is not "
+            f"position_mm / {robot}'s length ({expected})"
+          )
 
 
 def _check_triangular(matrix: list, size: int, where: str, refuse: record_fields.Refuse) -> None:
@@ -119,5 +146,7 @@ def _check_triangular(matrix: list, size: int, where: str, refuse: record_fields
     for configuration, value in enumerate(row):
       if (value is None) != (configuration > stage):
         expected = "null" if configuration > stage else "a number"
-        refuse(f"{where}[{stage}][{configuration}] is {value}; {expected} expected "
-               f"(null exactly above the diagonal)")
+        refuse(
+          f"{where}[{stage}][{configuration}] is {value}; {expected} expected "
+          f"(null exactly above the diagonal)"
+        )

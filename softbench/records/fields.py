@@ -5,8 +5,8 @@ seed and integrity fields, and the checks of those fields that a schema cannot m
 exp1s``'s) build their schemas from these parts, so that the two kinds cannot drift apart.
 """
 
-import datetime
 from collections.abc import Callable
+import datetime
 from typing import NoReturn
 
 from softbench import profiles
@@ -41,17 +41,20 @@ def section() -> dict:
 def properties() -> dict:
   """The schema of the fields every record has, by name."""
   return {
-      "softbench_version": {"type": "string", "minLength": 1},
-      "git_commit": {"type": ["string", "null"]},
-      "agent": {"type": "string", "pattern": AGENT_PATTERN, "maxLength": 64},
-      "profile": {"enum": list(profiles.PROFILES)},
-      "profile_settings": {"type": "object", "required": ["name"],
-                           "properties": {"name": {"type": "string"}}},
-      "seeds": {"type": "integer", "minimum": 1},
-      "wall_time_s": non_negative(MAX_WALL_TIME_S),
-      "date": {"type": "string", "format": "date-time"},
-      "machine": {"type": "object"},
-      INTEGRITY_FIELD: {"type": "string", "pattern": "^[0-9a-f]{64}$"},
+    "softbench_version": {"type": "string", "minLength": 1},
+    "git_commit": {"type": ["string", "null"]},
+    "agent": {"type": "string", "pattern": AGENT_PATTERN, "maxLength": 64},
+    "profile": {"enum": list(profiles.PROFILES)},
+    "profile_settings": {
+      "type": "object",
+      "required": ["name"],
+      "properties": {"name": {"type": "string"}},
+    },
+    "seeds": {"type": "integer", "minimum": 1},
+    "wall_time_s": non_negative(MAX_WALL_TIME_S),
+    "date": {"type": "string", "format": "date-time"},
+    "machine": {"type": "object"},
+    INTEGRITY_FIELD: {"type": "string", "pattern": "^[0-9a-f]{64}$"},
   }
 
 
@@ -67,8 +70,10 @@ def check(record: dict, refuse: Refuse, seed_entries: int | None = None) -> None
   if len(set(numbers)) != len(numbers):
     refuse(f"per_seed repeats a seed ({numbers})")
   if record["profile_settings"]["name"] != record["profile"]:
-    refuse(f"profile_settings.name {record['profile_settings']['name']!r} is not the profile "
-           f"{record['profile']!r}")
+    refuse(
+      f"profile_settings.name {record['profile_settings']['name']!r} is not the profile "
+      f"{record['profile']!r}"
+    )
   try:
     date = datetime.datetime.fromisoformat(record["date"])
   except ValueError:

@@ -14,19 +14,34 @@ import softbench
 
 def _git_commit() -> str | None:
   try:
-    commit = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
-                            check=True, cwd=pathlib.Path(__file__).parent).stdout.strip()
-    dirty = subprocess.run(["git", "status", "--porcelain"], capture_output=True, text=True,
-                           check=True, cwd=pathlib.Path(__file__).parent).stdout.strip()
+    commit = subprocess.run(
+      ["git", "rev-parse", "HEAD"],
+      capture_output=True,
+      text=True,
+      check=True,
+      cwd=pathlib.Path(__file__).parent,
+    ).stdout.strip()
+    dirty = subprocess.run(
+      ["git", "status", "--porcelain"],
+      capture_output=True,
+      text=True,
+      check=True,
+      cwd=pathlib.Path(__file__).parent,
+    ).stdout.strip()
   except (OSError, subprocess.CalledProcessError):
     return None
   return commit + ("-dirty" if dirty else "")
 
 
 def _machine(device: str) -> dict:
-  return {"platform": platform.platform(), "processor": _processor(),
-          "cpu_count": os.cpu_count(), "python": platform.python_version(),
-          "torch": metadata.version("torch"), "device": device}
+  return {
+    "platform": platform.platform(),
+    "processor": _processor(),
+    "cpu_count": os.cpu_count(),
+    "python": platform.python_version(),
+    "torch": metadata.version("torch"),
+    "device": device,
+  }
 
 
 def _processor() -> str:
@@ -48,9 +63,12 @@ def _processor() -> str:
 def provenance(device: str) -> dict:
   """Where and with what a run ran on ``device`` (torch's, e.g. ``cpu``); taken when it starts
   (the code may change while it runs)."""
-  return {"softbench_version": softbench.__version__, "git_commit": _git_commit(),
-          "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-          "machine": _machine(device)}
+  return {
+    "softbench_version": softbench.__version__,
+    "git_commit": _git_commit(),
+    "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+    "machine": _machine(device),
+  }
 
 
 def date_stamp(record: dict) -> str:

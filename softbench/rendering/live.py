@@ -6,15 +6,15 @@ Drawn in this process with the OpenGL backend dm_control loaded (``MUJOCO_GL``; 
 a headless one when it is unset).
 """
 
-import mujoco
-import numpy as np
 from dm_control.mujoco import engine
 from dm_control.mujoco import wrapper
+import mujoco
+import numpy as np
 
-from softbench.robots import base
 from softbench.rendering import markers
 from softbench.rendering import options as video_options
 from softbench.rendering import scene
+from softbench.robots import base
 
 _DECORATION_GEOMS = 64  # Scene geoms beyond the robot's: one target marker per scored module.
 
@@ -22,13 +22,19 @@ _DECORATION_GEOMS = 64  # Scene geoms beyond the robot's: one target marker per 
 class LiveView:
   """Renders the physics of an environment of ``robot``; ``start`` at every episode's reset."""
 
-  def __init__(self, robot: base.SoftArm, width: int | None = None, height: int | None = None,
-               camera: str | None = None):
+  def __init__(
+    self,
+    robot: base.SoftArm,
+    width: int | None = None,
+    height: int | None = None,
+    camera: str | None = None,
+  ):
     defaults = video_options.VideoOptions()
     self.options = video_options.VideoOptions(
-        width=defaults.width if width is None else width,
-        height=defaults.height if height is None else height,
-        camera=defaults.camera if camera is None else camera)
+      width=defaults.width if width is None else width,
+      height=defaults.height if height is None else height,
+      camera=defaults.camera if camera is None else camera,
+    )
     self.robot = robot
     self._framed = None  # The points the current scene frames.
     self._physics = self._camera = None
@@ -51,8 +57,14 @@ class LiveView:
     self._colours = scene.module_colours(model, self.robot.num_modules)[scored]
     self._radius = markers.target_radius(self.robot.length, scene.arm_radius(model))
     geoms = scene.robot_geom_budget(model) + _DECORATION_GEOMS
-    self._camera = engine.Camera(self._physics, options.height, options.width, options.camera,
-                                 max_geom=geoms, scene_callback=self._draw_targets)
+    self._camera = engine.Camera(
+      self._physics,
+      options.height,
+      options.width,
+      options.camera,
+      max_geom=geoms,
+      scene_callback=self._draw_targets,
+    )
     self._view = wrapper.MjvOption()
     self._view.sitegroup[:] = 0  # Cable holes and bellows anchors would clutter the picture.
     self._framed = points
@@ -60,8 +72,13 @@ class LiveView:
   def _draw_targets(self, physics, frame_scene: mujoco.MjvScene) -> None:
     del physics
     for target, colour in zip(self._targets, self._colours):
-      markers.add_geom(frame_scene, mujoco.mjtGeom.mjGEOM_SPHERE, (self._radius,) * 3, target,
-                       markers.target_rgba(colour))
+      markers.add_geom(
+        frame_scene,
+        mujoco.mjtGeom.mjGEOM_SPHERE,
+        (self._radius,) * 3,
+        target,
+        markers.target_rgba(colour),
+      )
 
   def render(self, physics, task) -> np.ndarray:
     """(height, width, 3) uint8: the arm as ``physics`` holds it, and ``task``'s current

@@ -7,12 +7,12 @@ markers and about ``MAX_PATH_SEGMENTS`` path segments per module (the path throu
 step, the same steps in every frame, so that it does not shimmer as it grows).
 """
 
-import functools
 from collections.abc import Sequence
+import functools
 
+from dm_control.mujoco import engine
 import mujoco
 import numpy as np
-from dm_control.mujoco import engine
 
 from softbench import episodes
 from softbench import metrics
@@ -40,8 +40,10 @@ def _tint(colour: np.ndarray, towards: np.ndarray, amount: float, alpha: float) 
 
 def _text_width(text: str, char_widths: Sequence[int]) -> int:
   """Pixel width of the widest line of ``text`` (ASCII) in a font of ``char_widths``."""
-  return max(sum(char_widths[min(ord(char), len(char_widths) - 1)] for char in line)
-             for line in text.split("\n"))
+  return max(
+    sum(char_widths[min(ord(char), len(char_widths) - 1)] for char in line)
+    for line in text.split("\n")
+  )
 
 
 def overlay_width(labels: str, values: str, char_widths: Sequence[int]) -> int:
@@ -83,8 +85,9 @@ def add_geom(scene: mujoco.MjvScene, kind: int, size, position, rgba) -> mujoco.
     return None
   scene.ngeom += 1  # The scene exposes its first ngeom geoms only.
   geom = scene.geoms[scene.ngeom - 1]
-  mujoco.mjv_initGeom(geom, kind, np.asarray(size, float), np.asarray(position, float),
-                      np.eye(3).ravel(), rgba)
+  mujoco.mjv_initGeom(
+    geom, kind, np.asarray(size, float), np.asarray(position, float), np.eye(3).ravel(), rgba
+  )
   geom.category = mujoco.mjtCatBit.mjCAT_DECOR
   return geom
 
@@ -93,8 +96,14 @@ class EpisodeMarkers:
   """The decorations of one episode; ``at(time, tips)`` moves them to a moment, then the object
   is a dm_control ``scene_callback`` that adds them to the scene."""
 
-  def __init__(self, episode: episodes.Episode, colours: np.ndarray, robot_length: float,
-               arm_radius: float, title: str):
+  def __init__(
+    self,
+    episode: episodes.Episode,
+    colours: np.ndarray,
+    robot_length: float,
+    arm_radius: float,
+    title: str,
+  ):
     """``colours``: (num_modules, 4) every module's colour; ``robot_length`` and ``arm_radius``
     (m) scale the markers; ``title``: the caption's first line."""
     self._episode = episode
@@ -137,7 +146,7 @@ class EpisodeMarkers:
     """(points, 3) the tip path of ``module`` (index among scored) up to now."""
     done = int(np.floor(self._time + 1e-9))
     stride = self._path_stride
-    reached = self._episode.achieved[stride - 1:done:stride, module, :3]
+    reached = self._episode.achieved[stride - 1 : done : stride, module, :3]
     return np.concatenate([self._starts[None, module], reached, self._tips[None, module]])
 
   def __call__(self, physics, scene: mujoco.MjvScene) -> None:
@@ -150,8 +159,7 @@ class EpisodeMarkers:
       trail_rgba = _tint(colour, _WHITE, 0.45, TRAIL_ALPHA)
       for point in self._trails[module]:
         add(sphere, (TRAIL_RADIUS * self._length,) * 3, point, trail_rgba)
-      add(sphere, (self._target_radius,) * 3, current[module],
-          target_rgba(colour))
+      add(sphere, (self._target_radius,) * 3, current[module], target_rgba(colour))
       path = self._path(module)
       path_rgba = _tint(colour, np.zeros(4), 0.35, 1.0)
       for start, end in zip(path[:-1], path[1:]):
@@ -159,11 +167,13 @@ class EpisodeMarkers:
           continue
         geom = add(mujoco.mjtGeom.mjGEOM_CAPSULE, np.zeros(3), start, path_rgba)
         if geom is not None:
-          mujoco.mjv_connector(geom, mujoco.mjtGeom.mjGEOM_CAPSULE, PATH_RADIUS * self._length,
-                               start, end)
+          mujoco.mjv_connector(
+            geom, mujoco.mjtGeom.mjGEOM_CAPSULE, PATH_RADIUS * self._length, start, end
+          )
 
-  def caption(self, height: int, width: int,
-              char_widths: Sequence[int]) -> tuple[engine.TextOverlay, ...]:
+  def caption(
+    self, height: int, width: int, char_widths: Sequence[int]
+  ) -> tuple[engine.TextOverlay, ...]:
     """The title (top left, wrapped to the frame's width), the step with the mean tip error of
     the scored modules after it (bottom right) and, where it fits beside them, a legend (bottom
     left), for frames of ``height`` x ``width`` pixels (none if small). ``char_widths``: pixel
@@ -176,11 +186,17 @@ class EpisodeMarkers:
     status_labels = "step\nmean tip error"
     widest_status = f"{steps} of {steps}\n{self._errors_mm.mean(axis=1).max():.1f} mm"
     legend = ("dots\nline", "target\ntip path")
-    overlays = [engine.TextOverlay(_wrap(self._title, width, char_widths), "", style="normal",
-                                   position="top left"),
-                engine.TextOverlay(status_labels, f"{done} of {steps}\n{error}", style="normal",
-                                   position="bottom right")]
-    if (overlay_width(*legend, char_widths)
-        + overlay_width(status_labels, widest_status, char_widths) <= width):
+    overlays = [
+      engine.TextOverlay(
+        _wrap(self._title, width, char_widths), "", style="normal", position="top left"
+      ),
+      engine.TextOverlay(
+        status_labels, f"{done} of {steps}\n{error}", style="normal", position="bottom right"
+      ),
+    ]
+    if (
+      overlay_width(*legend, char_widths) + overlay_width(status_labels, widest_status, char_widths)
+      <= width
+    ):
       overlays.append(engine.TextOverlay(*legend, style="normal", position="bottom left"))
     return tuple(overlays)

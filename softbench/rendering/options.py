@@ -46,20 +46,33 @@ class VideoOptions:
   def __post_init__(self):
     for name in ("width", "height"):
       value = getattr(self, name)
-      if (isinstance(value, bool) or not isinstance(value, numbers.Integral)
-          or not MIN_SIZE <= value <= MAX_SIZE or value % 2):
-        raise ValueError(f"{name} must be an even number of pixels from {MIN_SIZE} to "
-                         f"{MAX_SIZE}, got {value!r}")
-    if (isinstance(self.fps, bool) or not isinstance(self.fps, numbers.Real)
-        or not math.isfinite(self.fps) or not 0 < self.fps <= MAX_FPS):
+      if (
+        isinstance(value, bool)
+        or not isinstance(value, numbers.Integral)
+        or not MIN_SIZE <= value <= MAX_SIZE
+        or value % 2
+      ):
+        raise ValueError(
+          f"{name} must be an even number of pixels from {MIN_SIZE} to {MAX_SIZE}, got {value!r}"
+        )
+    if (
+      isinstance(self.fps, bool)
+      or not isinstance(self.fps, numbers.Real)
+      or not math.isfinite(self.fps)
+      or not 0 < self.fps <= MAX_FPS
+    ):
       raise ValueError(f"fps must be a number above 0 and at most {MAX_FPS:g}, got {self.fps!r}")
     if self.camera not in CAMERAS:
       raise ValueError(f"unknown camera {self.camera!r}; choose one of {', '.join(CAMERAS)}")
-    if (isinstance(self.frames_per_step, bool)
-        or not isinstance(self.frames_per_step, numbers.Integral)
-        or not 1 <= self.frames_per_step <= MAX_FRAMES_PER_STEP):
-      raise ValueError(f"frames per step must be an integer from 1 to {MAX_FRAMES_PER_STEP}, "
-                       f"got {self.frames_per_step!r}")
+    if (
+      isinstance(self.frames_per_step, bool)
+      or not isinstance(self.frames_per_step, numbers.Integral)
+      or not 1 <= self.frames_per_step <= MAX_FRAMES_PER_STEP
+    ):
+      raise ValueError(
+        f"frames per step must be an integer from 1 to {MAX_FRAMES_PER_STEP}, "
+        f"got {self.frames_per_step!r}"
+      )
 
   def frame_count(self, steps: int) -> int:
     """Frames of an episode of ``steps`` control steps: the start, then frames_per_step each."""

@@ -47,13 +47,16 @@ class Replay:
 def _check(physics: arm_physics.SoftArmPhysics, expected: np.ndarray, step: int) -> None:
   deviation = float(np.max(np.abs(physics.module_poses() - expected)))
   if deviation > POSE_TOLERANCE:
-    raise RuntimeError(f"the replay left the recorded episode at control step {step} (pose "
-                       f"entries differ by up to {deviation:.3g}); was it recorded with other "
-                       f"task options or another seed?")
+    raise RuntimeError(
+      f"the replay left the recorded episode at control step {step} (pose "
+      f"entries differ by up to {deviation:.3g}); was it recorded with other "
+      f"task options or another seed?"
+    )
 
 
-def moments(replay: Replay,
-            frames_per_step: int) -> Iterator[tuple[float, arm_physics.SoftArmPhysics]]:
+def moments(
+  replay: Replay, frames_per_step: int
+) -> Iterator[tuple[float, arm_physics.SoftArmPhysics]]:
   """Yields (time in control steps, physics at that time): the start, then ``frames_per_step``
   moments evenly spaced over every control period, the last at its end.
 
@@ -66,8 +69,10 @@ def moments(replay: Replay,
   physics = env.physics
   sub_steps = int(round(replay.robot.control_timestep / physics.timestep()))
   if frames_per_step > sub_steps:
-    raise ValueError(f"frames per step must be at most {sub_steps} for {replay.robot.name} "
-                     f"(physics steps per control period), got {frames_per_step}")
+    raise ValueError(
+      f"frames per step must be at most {sub_steps} for {replay.robot.name} "
+      f"(physics steps per control period), got {frames_per_step}"
+    )
   bounds = np.linspace(0, sub_steps, frames_per_step + 1).round().astype(int)
   _check(physics, replay.episode.poses[0], 0)
   yield 0.0, physics

@@ -17,10 +17,10 @@ FOVY_DEG = 45.0  # (deg) Vertical field of view of every camera (MuJoCo's defaul
 FRAME_MARGIN = 1.2  # Framed half-extent over the episode's half-extent.
 FLOOR_GAP = 0.35  # Floor distance below the lowest visited point, in arm lengths.
 _VIEWS = {  # Camera viewing direction: azimuth and elevation (deg) of where it looks.
-    "workspace": (50.0, -25.0),
-    "front": (90.0, 0.0),
-    "side": (180.0, 0.0),
-    "below": (90.0, 90.0),
+  "workspace": (50.0, -25.0),
+  "front": (90.0, 0.0),
+  "side": (180.0, 0.0),
+  "below": (90.0, 90.0),
 }
 _SKY_RGB = ((0.55, 0.65, 0.75), (0.12, 0.14, 0.18))  # Top and bottom of the gradient sky.
 _FLOOR_RGB = ((0.32, 0.34, 0.38), (0.26, 0.28, 0.32))  # Checker squares.
@@ -32,15 +32,17 @@ _ROBOT_GEOM_ALLOWANCE = 4  # Scene geoms per model element (bodies, geoms, tendo
 
 def module_colours(model: mujoco.MjModel, num_modules: int) -> np.ndarray:
   """(num_modules, 4) the colour of each module, as its first segment is drawn."""
-  return np.array([model.geom(f"{chain.segment_name(k, 1)}_geom").rgba
-                   for k in range(1, num_modules + 1)])
+  return np.array(
+    [model.geom(f"{chain.segment_name(k, 1)}_geom").rgba for k in range(1, num_modules + 1)]
+  )
 
 
 def episode_points(episode: episodes.Episode) -> np.ndarray:
   """(n, 3) every point of ``episode`` a frame shows: each module's tip at every step and every
   target position (m)."""
-  return np.concatenate([episode.poses[..., :3].reshape(-1, 3),
-                         episode.targets[..., :3].reshape(-1, 3)])
+  return np.concatenate(
+    [episode.poses[..., :3].reshape(-1, 3), episode.targets[..., :3].reshape(-1, 3)]
+  )
 
 
 def base_plate_points(model: mujoco.MjModel) -> np.ndarray:
@@ -54,16 +56,18 @@ def base_plate_points(model: mujoco.MjModel) -> np.ndarray:
 def _view_axes(camera: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
   """Unit right, up and forward (viewing) directions of ``camera`` in world coordinates."""
   azimuth, elevation = np.radians(_VIEWS[camera])
-  forward = np.array([np.cos(elevation) * np.cos(azimuth), np.cos(elevation) * np.sin(azimuth),
-                      np.sin(elevation)])
+  forward = np.array(
+    [np.cos(elevation) * np.cos(azimuth), np.cos(elevation) * np.sin(azimuth), np.sin(elevation)]
+  )
   up_hint = np.array([0.0, 0.0, 1.0]) if abs(forward[2]) < 0.99 else np.array([0.0, 1.0, 0.0])
   right = np.cross(forward, up_hint)
   right /= np.linalg.norm(right)
   return right, np.cross(right, forward), forward
 
 
-def camera_pose(camera: str, points: np.ndarray, padding: float,
-                aspect: float) -> tuple[np.ndarray, np.ndarray]:
+def camera_pose(
+  camera: str, points: np.ndarray, padding: float, aspect: float
+) -> tuple[np.ndarray, np.ndarray]:
   """Position (m) and orientation (quaternion) of ``camera`` such that every point, grown by
   ``padding`` (m) and ``FRAME_MARGIN``, lies in its view for frames of ``aspect`` = width /
   height."""
@@ -105,23 +109,47 @@ def scene_model(robot: base.SoftArm, points: np.ndarray, width: int, height: int
   spec.visual.headlight.ambient = (0.35, 0.35, 0.35)
   spec.visual.headlight.diffuse = (0.55, 0.55, 0.55)
   spec.visual.headlight.specular = (0.1, 0.1, 0.1)
-  spec.add_texture(name="video_sky", type=mujoco.mjtTexture.mjTEXTURE_SKYBOX,
-                   builtin=mujoco.mjtBuiltin.mjBUILTIN_GRADIENT, rgb1=_SKY_RGB[0],
-                   rgb2=_SKY_RGB[1], width=256, height=1536)
-  spec.add_texture(name="video_floor", type=mujoco.mjtTexture.mjTEXTURE_2D,
-                   builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER, rgb1=_FLOOR_RGB[0],
-                   rgb2=_FLOOR_RGB[1], width=64, height=64)
+  spec.add_texture(
+    name="video_sky",
+    type=mujoco.mjtTexture.mjTEXTURE_SKYBOX,
+    builtin=mujoco.mjtBuiltin.mjBUILTIN_GRADIENT,
+    rgb1=_SKY_RGB[0],
+    rgb2=_SKY_RGB[1],
+    width=256,
+    height=1536,
+  )
+  spec.add_texture(
+    name="video_floor",
+    type=mujoco.mjtTexture.mjTEXTURE_2D,
+    builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER,
+    rgb1=_FLOOR_RGB[0],
+    rgb2=_FLOOR_RGB[1],
+    width=64,
+    height=64,
+  )
   floor_material = spec.add_material(name="video_floor")
   floor_material.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = "video_floor"
   floor_material.texuniform = True
   floor_material.texrepeat = (_FLOOR_SQUARES_PER_ARM_LENGTH / length,) * 2
   floor_z = points[:, 2].min() - FLOOR_GAP * length
-  spec.worldbody.add_geom(name="video_floor", type=mujoco.mjtGeom.mjGEOM_PLANE,
-                          size=(0, 0, 0.05), pos=(0, 0, floor_z), material="video_floor",
-                          contype=0, conaffinity=0)
-  spec.worldbody.add_light(name="video_key_light", pos=(0.5 * length, -0.5 * length, 2 * length),
-                           dir=(-0.25, 0.25, -1.0), type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
-                           diffuse=(0.5, 0.5, 0.5), specular=(0.2, 0.2, 0.2), castshadow=False)
+  spec.worldbody.add_geom(
+    name="video_floor",
+    type=mujoco.mjtGeom.mjGEOM_PLANE,
+    size=(0, 0, 0.05),
+    pos=(0, 0, floor_z),
+    material="video_floor",
+    contype=0,
+    conaffinity=0,
+  )
+  spec.worldbody.add_light(
+    name="video_key_light",
+    pos=(0.5 * length, -0.5 * length, 2 * length),
+    dir=(-0.25, 0.25, -1.0),
+    type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
+    diffuse=(0.5, 0.5, 0.5),
+    specular=(0.2, 0.2, 0.2),
+    castshadow=False,
+  )
   for camera in options.CAMERAS:
     position, quaternion = camera_pose(camera, points, padding, width / height)
     spec.worldbody.add_camera(name=camera, pos=position, quat=quaternion, fovy=FOVY_DEG)
@@ -130,8 +158,9 @@ def scene_model(robot: base.SoftArm, points: np.ndarray, width: int, height: int
 
 def robot_geom_budget(model: mujoco.MjModel) -> int:
   """Scene geoms to allow for drawing the robot of ``model`` (bodies, geoms, tendon pieces...)."""
-  return _ROBOT_GEOM_ALLOWANCE * (model.nbody + model.ngeom + model.nsite + model.nwrap
-                                  + model.ntendon)
+  return _ROBOT_GEOM_ALLOWANCE * (
+    model.nbody + model.ngeom + model.nsite + model.nwrap + model.ntendon
+  )
 
 
 def arm_radius(model: mujoco.MjModel) -> float:

@@ -26,8 +26,8 @@ from softbench.rendering import worker
 
 OFFSCREEN_BACKENDS = ("egl", "osmesa")
 INSTALL_HINTS = {
-    "egl": "EGL (Debian/Ubuntu: apt-get install libegl1 libgl1-mesa-dri)",
-    "osmesa": "OSMesa (Debian/Ubuntu: apt-get install libosmesa6)",
+  "egl": "EGL (Debian/Ubuntu: apt-get install libegl1 libgl1-mesa-dri)",
+  "osmesa": "OSMesa (Debian/Ubuntu: apt-get install libosmesa6)",
 }
 
 
@@ -90,8 +90,12 @@ def _render_in_child(request: dict, backend: str, progress: Progress, bar) -> tu
     request_path.write_bytes(pickle.dumps(request))
     with open(pathlib.Path(folder) / "stderr.txt", "w+") as errors:
       child = subprocess.Popen(
-          [sys.executable, "-m", worker.__name__, str(request_path), str(result_path)],
-          stdout=subprocess.PIPE, stderr=errors, text=True, env=_child_environment(backend))
+        [sys.executable, "-m", worker.__name__, str(request_path), str(result_path)],
+        stdout=subprocess.PIPE,
+        stderr=errors,
+        text=True,
+        env=_child_environment(backend),
+      )
       ready = False
       try:
         for line in child.stdout:
@@ -115,9 +119,12 @@ def _render_in_child(request: dict, backend: str, progress: Progress, bar) -> tu
   raise RenderingFailed(f"rendering with {backend} failed: {message}")
 
 
-def render(replay: episode_replay.Replay, output: str | os.PathLike,
-           options: video_options.VideoOptions = video_options.VideoOptions(),
-           show_progress: bool = False) -> VideoStats:
+def render(
+  replay: episode_replay.Replay,
+  output: str | os.PathLike,
+  options: video_options.VideoOptions = video_options.VideoOptions(),
+  show_progress: bool = False,
+) -> VideoStats:
   """Writes the frames of ``replay`` to ``output``: an ``.mp4`` video (H.264, ``options.fps``)
   or an ``.npy`` array (frames, height, width, 3) of uint8.
 
@@ -135,23 +142,32 @@ def render(replay: episode_replay.Replay, output: str | os.PathLike,
   progress = progress_bars.counting(show_progress, transient=True)
   with progress:
     for backend in backend_candidates():
-      bar = progress.add_task(f"rendering {output.name} ({backend})",
-                              total=options.frame_count(replay.steps))
+      bar = progress.add_task(
+        f"rendering {output.name} ({backend})", total=options.frame_count(replay.steps)
+      )
       result, opened = _render_in_child(request, backend, progress, bar)
       if opened:
-        return VideoStats(output, result["frames"], result["backend"], result["render_seconds"],
-                          time.perf_counter() - started, output.stat().st_size)
+        return VideoStats(
+          output,
+          result["frames"],
+          result["backend"],
+          result["render_seconds"],
+          time.perf_counter() - started,
+          output.stat().st_size,
+        )
       failures[backend] = result["error"]
       progress.remove_task(bar)
   tried = "; ".join(f"{backend}: {error}" for backend, error in failures.items())
   install = " or ".join(INSTALL_HINTS.values())
-  raise RenderingUnavailable(f"no OpenGL backend can render off-screen here ({tried}); install "
-                             f"{install}, or set MUJOCO_GL to a backend that works")
+  raise RenderingUnavailable(
+    f"no OpenGL backend can render off-screen here ({tried}); install "
+    f"{install}, or set MUJOCO_GL to a backend that works"
+  )
 
 
-def render_frames(replay: episode_replay.Replay,
-                  options: video_options.VideoOptions = video_options.VideoOptions()
-                  ) -> np.ndarray:
+def render_frames(
+  replay: episode_replay.Replay, options: video_options.VideoOptions = video_options.VideoOptions()
+) -> np.ndarray:
   """(frames, height, width, 3) uint8: every frame of ``replay``, as ``render`` draws them."""
   with tempfile.TemporaryDirectory(prefix="softbench-frames-") as folder:
     path = pathlib.Path(folder) / "frames.npy"

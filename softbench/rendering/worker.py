@@ -27,6 +27,7 @@ CRF = 20  # H.264 constant rate factor: lower is better quality and larger files
 def _open_backend() -> str:
   """Opens and frees a small off-screen context; returns dm_control's backend name."""
   from dm_control import _render  # pylint: disable=import-outside-toplevel
+
   context = _render.Renderer(max_width=16, max_height=16)
   context.free()
   return _render.BACKEND
@@ -60,8 +61,9 @@ def _render(request: dict) -> dict:
       np.save(partial, np.stack(images))
     else:
       mediapy.set_ffmpeg(imageio_ffmpeg.get_ffmpeg_exe())
-      with mediapy.VideoWriter(partial, (options.height, options.width), fps=options.fps,
-                               codec="h264", crf=CRF) as writer:
+      with mediapy.VideoWriter(
+        partial, (options.height, options.width), fps=options.fps, codec="h264", crf=CRF
+      ) as writer:
         for image in episode_frames.frames():
           writer.add_image(image)
           count += 1

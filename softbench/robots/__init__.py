@@ -9,7 +9,9 @@ import re
 
 from softbench.robots.base import SoftArm
 from softbench.robots.pneumatic import PneumaticArm
-from softbench.robots.tendon import MAX_MODULES, CableDrivenArm, TendonArm
+from softbench.robots.tendon import MAX_MODULES
+from softbench.robots.tendon import CableDrivenArm
+from softbench.robots.tendon import TendonArm
 from softbench.robots.tendon_local import LocalTendonArm
 
 TENDON_FAMILIES = {family.FAMILY: family for family in (TendonArm, LocalTendonArm)}
@@ -57,9 +59,11 @@ class Family:
 
 BENCHMARK_MODULES = range(1, 6)  # N of the benchmark tendon arms, tendon-1 .. tendon-5.
 FAMILIES = (
-    *(Family(name, arm, True, tuple(f"{name}-{n}" for n in BENCHMARK_MODULES))
-      for name, arm in TENDON_FAMILIES.items()),
-    Family("pneumatic-433", PneumaticArm, False, ("pneumatic-433",)),
+  *(
+    Family(name, arm, True, tuple(f"{name}-{n}" for n in BENCHMARK_MODULES))
+    for name, arm in TENDON_FAMILIES.items()
+  ),
+  Family("pneumatic-433", PneumaticArm, False, ("pneumatic-433",)),
 )
 """Every robot family; a new one is an arm class and one entry here. A name belongs to the
 longest family name it starts with (``tendon-local-x`` is a malformed ``tendon-local`` name)."""
@@ -92,9 +96,11 @@ def make(name: str, **overrides) -> SoftArm:
     raise ValueError(f"robot name must be a string, got {name!r}")
   if family := family_of(name):
     return family.build(name, overrides)
-  raise ValueError(f"unknown robot {name!r}; choose "
-                   f"{' or '.join(family.usage for family in FAMILIES)} (N = 1 to "
-                   f"{MAX_MODULES})")
+  raise ValueError(
+    f"unknown robot {name!r}; choose "
+    f"{' or '.join(family.usage for family in FAMILIES)} (N = 1 to "
+    f"{MAX_MODULES})"
+  )
 
 
 def _checked(family: type, overrides: dict) -> dict:
@@ -105,6 +111,19 @@ def _checked(family: type, overrides: dict) -> dict:
   return overrides
 
 
-__all__ = ["BENCHMARK_ROBOTS", "FAMILIES", "MAX_MODULES", "NAME_PATTERN", "TENDON_FAMILIES",
-           "CableDrivenArm", "Family", "LocalTendonArm", "PneumaticArm", "SoftArm", "TendonArm",
-           "family_of", "make", "tendon_family"]
+__all__ = [
+  "BENCHMARK_ROBOTS",
+  "FAMILIES",
+  "MAX_MODULES",
+  "NAME_PATTERN",
+  "TENDON_FAMILIES",
+  "CableDrivenArm",
+  "Family",
+  "LocalTendonArm",
+  "PneumaticArm",
+  "SoftArm",
+  "TendonArm",
+  "family_of",
+  "make",
+  "tendon_family",
+]

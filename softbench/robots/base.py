@@ -124,8 +124,9 @@ class SoftArm(abc.ABC):
     """Actions (..., action_dim) that bend every module alike towards the planar actuation
     points (..., 2), i.e. ``x * bend_basis[0] + y * bend_basis[1]``, clipped to [-1, 1]."""
     points = np.asarray(points, dtype=float)
-    action = np.concatenate([points @ self.bend_basis(k) for k in range(1, self.num_modules + 1)],
-                            axis=-1)
+    action = np.concatenate(
+      [points @ self.bend_basis(k) for k in range(1, self.num_modules + 1)], axis=-1
+    )
     return np.clip(action, -1.0, 1.0)
 
   def action_map(self) -> np.ndarray:
@@ -140,8 +141,9 @@ class SoftArm(abc.ABC):
   def refined(self, factor: int) -> "SoftArm":
     """The same robot with ``factor`` times more segments and a time step ``factor`` times
     shorter, to measure discretisation error."""
-    return dataclasses.replace(self, segments_per_module=self.segments_per_module * factor,
-                               timestep=self.timestep / factor)
+    return dataclasses.replace(
+      self, segments_per_module=self.segments_per_module * factor, timestep=self.timestep / factor
+    )
 
   def with_faults(self, faults) -> "SoftArm":
     """The same robot with ``faults`` (an iterable of ``Fault``) instead of its own; raises a

@@ -75,13 +75,15 @@ class ChainGeometry:
 
   def module_start(self, module: int) -> float:
     """Arc length (m) of the proximal end of a module."""
-    return float(sum(self.module_lengths[:module - 1]))
+    return float(sum(self.module_lengths[: module - 1]))
 
   def joint_arc_lengths(self) -> list[float]:
     """Arc length (m) of every joint, in chain order."""
-    return [self.module_start(k) + (i - 0.5) * self.segment_length(k)
-            for k in range(1, self.num_modules + 1)
-            for i in range(1, self.segments_per_module + 1)]
+    return [
+      self.module_start(k) + (i - 0.5) * self.segment_length(k)
+      for k in range(1, self.num_modules + 1)
+      for i in range(1, self.segments_per_module + 1)
+    ]
 
 
 def segment_name(module: int, segment: int) -> str:
@@ -101,8 +103,7 @@ def tip_site_name(module: int) -> str:
 class Chain:
   """The bodies of a built chain, and where along the rod each one starts."""
 
-  def __init__(self, bodies: list[mujoco.MjsBody], origins: list[float],
-               geometry: ChainGeometry):
+  def __init__(self, bodies: list[mujoco.MjsBody], origins: list[float], geometry: ChainGeometry):
     self.bodies = bodies  # The clamp first, then every segment.
     self.origins = origins  # Rest arc length (m) of each body's origin.
     self.geometry = geometry
@@ -113,16 +114,16 @@ class Chain:
     index = max(index, 0)
     return self.bodies[index], arc_length - self.origins[index]
 
-  def channel_holes(self, inset_fraction: float, start: float = 0.0,
-                    end: float = math.inf) -> list[tuple[str, float]]:
+  def channel_holes(
+    self, inset_fraction: float, start: float = 0.0, end: float = math.inf
+  ) -> list[tuple[str, float]]:
     """Where a tendon running in a channel along the rod is held, as (label, arc length) with
     ``start <= arc length < end``: near both ends of every body, ``inset_fraction`` of a segment
     from each joint, so the short stretch crossing a joint passes it at the channel's offset and
     the moment the joint sees converges to tension x offset as segments shrink."""
     joints = self.geometry.joint_arc_lengths()
     n = self.geometry.segments_per_module
-    insets = [inset_fraction * self.geometry.segment_length(i // n + 1)
-              for i in range(len(joints))]
+    insets = [inset_fraction * self.geometry.segment_length(i // n + 1) for i in range(len(joints))]
     holes = [(f"{self.bodies[0].name}_distal", joints[0] - insets[0])]
     for index in range(len(joints)):
       name = self.bodies[index + 1].name
@@ -131,19 +132,20 @@ class Chain:
         holes.append((f"{name}_distal", joints[index + 1] - insets[index + 1]))
     return [(label, s) for label, s in holes if start <= s < end]
 
-  def add_site(self, name: str, arc_length: float, offset: Sequence[float] = (0.0, 0.0),
-               **attributes) -> mujoco.MjsSite:
+  def add_site(
+    self, name: str, arc_length: float, offset: Sequence[float] = (0.0, 0.0), **attributes
+  ) -> mujoco.MjsSite:
     """Adds a site at ``arc_length`` along the rod, ``offset`` = (local y, local z) off its axis."""
     body, x = self.locate(arc_length)
     return body.add_site(name=name, pos=(x, offset[0], offset[1]), **attributes)
 
 
 def add_chain(
-    parent: mujoco.MjsBody,
-    geometry: ChainGeometry,
-    joints: SegmentJoints,
-    rgba: Sequence[Sequence[float]],
-    cable_plugin: mujoco.MjsPlugin | None = None,
+  parent: mujoco.MjsBody,
+  geometry: ChainGeometry,
+  joints: SegmentJoints,
+  rgba: Sequence[Sequence[float]],
+  cable_plugin: mujoco.MjsPlugin | None = None,
 ) -> Chain:
   """Adds the clamp and the segments below ``parent``, and a tip site per module.
 
@@ -157,8 +159,14 @@ def add_chain(
   # it is a full segment; its geometry covers the rod's first half segment, below the base.
   clamp_origin = -first_length / 2
   body = parent.add_body(name=CLAMP, pos=(0, 0, -clamp_origin), quat=X_TO_Z_QUAT)
-  _add_rod_geom(body, f"{CLAMP}_geom", 0.0 - clamp_origin, joint_s[0] - clamp_origin, geometry,
-                (0.3, 0.3, 0.3, 1))
+  _add_rod_geom(
+    body,
+    f"{CLAMP}_geom",
+    0.0 - clamp_origin,
+    joint_s[0] - clamp_origin,
+    geometry,
+    (0.3, 0.3, 0.3, 1),
+  )
   if cable_plugin is not None:
     body.plugin = cable_plugin
   bodies, origins = [body], [clamp_origin]
@@ -175,31 +183,55 @@ def add_chain(
     origins.append(start)
   built = Chain(bodies, origins, geometry)
   for module in range(1, geometry.num_modules + 1):
-    built.add_site(tip_site_name(module),
-                   geometry.module_start(module) + geometry.module_lengths[module - 1],
-                   quat=X_TO_Z_QUAT, size=(geometry.radius * 0.6, 0, 0), rgba=(1, 1, 1, 1))
+    built.add_site(
+      tip_site_name(module),
+      geometry.module_start(module) + geometry.module_lengths[module - 1],
+      quat=X_TO_Z_QUAT,
+      size=(geometry.radius * 0.6, 0, 0),
+      rgba=(1, 1, 1, 1),
+    )
   return built
 
 
-def _add_rod_geom(body: mujoco.MjsBody, name: str, start: float, end: float,
-                  geometry: ChainGeometry, rgba: Sequence[float]) -> None:
+def _add_rod_geom(
+  body: mujoco.MjsBody,
+  name: str,
+  start: float,
+  end: float,
+  geometry: ChainGeometry,
+  rgba: Sequence[float],
+) -> None:
   # Cylinders, not capsules: a capsule's caps would overlap its neighbours' and add mass. The
   # cable plugin reads the radius of each body's first geom for E·I and G·J.
-  body.add_geom(name=name, type=mujoco.mjtGeom.mjGEOM_CYLINDER, fromto=(start, 0, 0, end, 0, 0),
-                size=(geometry.radius, 0, 0), density=geometry.density, rgba=rgba,
-                contype=0, conaffinity=0)
+  body.add_geom(
+    name=name,
+    type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+    fromto=(start, 0, 0, end, 0, 0),
+    size=(geometry.radius, 0, 0),
+    density=geometry.density,
+    rgba=rgba,
+    contype=0,
+    conaffinity=0,
+  )
 
 
 def _add_joints(body: mujoco.MjsBody, name: str, joints: SegmentJoints, spacing: float) -> None:
   if joints.slide_stiffness is not None:
     body.add_joint(
-        name=f"{name}_slide", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=(1, 0, 0),
-        stiffness=joints.slide_stiffness, damping=joints.slide_damping,
-        armature=joints.armature)
+      name=f"{name}_slide",
+      type=mujoco.mjtJoint.mjJNT_SLIDE,
+      axis=(1, 0, 0),
+      stiffness=joints.slide_stiffness,
+      damping=joints.slide_damping,
+      armature=joints.armature,
+    )
   body.add_joint(
-      name=f"{name}_ball", type=mujoco.mjtJoint.mjJNT_BALL,
-      stiffness=joints.bending_stiffness / spacing, damping=joints.ball_damping,
-      armature=joints.armature)
+    name=f"{name}_ball",
+    type=mujoco.mjtJoint.mjJNT_BALL,
+    stiffness=joints.bending_stiffness / spacing,
+    damping=joints.ball_damping,
+    armature=joints.armature,
+  )
 
 
 def ring_offsets(radius: float, angles_deg: Sequence[float]) -> list[tuple[float, float]]:

@@ -53,14 +53,24 @@ class Fault:
   gain: float
 
   def __post_init__(self):
-    if isinstance(self.module, bool) or not isinstance(self.module, numbers.Integral) \
-        or self.module < 1:
+    if (
+      isinstance(self.module, bool)
+      or not isinstance(self.module, numbers.Integral)
+      or self.module < 1
+    ):
       raise ValueError(f"fault module must be an integer from 1, got {self.module!r}")
-    if isinstance(self.actuator, bool) or not isinstance(self.actuator, numbers.Integral) \
-        or self.actuator < 0:
+    if (
+      isinstance(self.actuator, bool)
+      or not isinstance(self.actuator, numbers.Integral)
+      or self.actuator < 0
+    ):
       raise ValueError(f"fault actuator must be an integer from 0, got {self.actuator!r}")
-    if (isinstance(self.gain, bool) or not isinstance(self.gain, numbers.Real)
-        or not math.isfinite(self.gain) or not 0.0 <= self.gain <= 1.0):
+    if (
+      isinstance(self.gain, bool)
+      or not isinstance(self.gain, numbers.Real)
+      or not math.isfinite(self.gain)
+      or not 0.0 <= self.gain <= 1.0
+    ):
       raise ValueError(f"fault gain must lie in [0, 1] (0: punctured), got {self.gain!r}")
     object.__setattr__(self, "gain", float(self.gain) + 0.0)  # A float, and -0.0 becomes 0.0.
 
@@ -97,8 +107,9 @@ def module_actuators(robot) -> list[list[int]]:
   slices = robot.module_action_slices()
   groups = [[] for _ in slices]
   for index, actuator_map in enumerate(robot.actuator_maps()):
-    module = next(k for k, part in enumerate(slices)
-                  if part.start <= actuator_map.action_index < part.stop)
+    module = next(
+      k for k, part in enumerate(slices) if part.start <= actuator_map.action_index < part.stop
+    )
     groups[module].append(index)
   return groups
 
@@ -111,15 +122,20 @@ def check(robot, faults: tuple[Fault, ...]) -> None:
   seen = set()
   for fault in faults:
     if fault.module > len(groups):
-      raise ValueError(f"fault {fault}: {robot.name} has modules 1 to {len(groups)}, "
-                       f"not {fault.module}")
+      raise ValueError(
+        f"fault {fault}: {robot.name} has modules 1 to {len(groups)}, not {fault.module}"
+      )
     count = len(groups[fault.module - 1])
     if fault.actuator >= count:
-      raise ValueError(f"fault {fault}: module {fault.module} of {robot.name} has actuators 0 to "
-                       f"{count - 1}, not {fault.actuator}")
+      raise ValueError(
+        f"fault {fault}: module {fault.module} of {robot.name} has actuators 0 to "
+        f"{count - 1}, not {fault.actuator}"
+      )
     if (fault.module, fault.actuator) in seen:
-      raise ValueError(f"fault {fault}: actuator {fault.actuator} of module {fault.module} is "
-                       f"given more than one fault")
+      raise ValueError(
+        f"fault {fault}: actuator {fault.actuator} of module {fault.module} is "
+        f"given more than one fault"
+      )
     seen.add((fault.module, fault.actuator))
 
 
@@ -138,5 +154,11 @@ def apply(spec: mujoco.MjSpec, robot) -> None:
 def describe(robot, fault: Fault) -> dict:
   """The fault as a result record holds it: its fields, text form and MuJoCo actuator name."""
   name = robot.build_spec().actuators[actuator_index(robot, fault)].name
-  return {"module": fault.module, "actuator": fault.actuator, "gain": fault.gain,
-          "text": str(fault), "actuator_name": name, "punctured": fault.punctured}
+  return {
+    "module": fault.module,
+    "actuator": fault.actuator,
+    "gain": fault.gain,
+    "text": str(fault),
+    "actuator_name": name,
+    "punctured": fault.punctured,
+  }

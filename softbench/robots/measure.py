@@ -7,8 +7,8 @@ the seed passed in, so the same robot gives the same figures.
 import time
 
 import mujoco
-import numpy as np
 from mujoco import rollout
+import numpy as np
 
 from softbench.robots import base
 from softbench.robots import chain
@@ -20,8 +20,9 @@ WORKSPACE_SAMPLES = 200  # Random actions whose poses outline the workspace.
 DISCRETISATION_REFINEMENT = 4  # The finer model has this many times more segments.
 
 
-def tip_trajectory(robot: base.SoftArm, actions: np.ndarray, hold_seconds: float,
-                   model: mujoco.MjModel | None = None) -> np.ndarray:
+def tip_trajectory(
+  robot: base.SoftArm, actions: np.ndarray, hold_seconds: float, model: mujoco.MjModel | None = None
+) -> np.ndarray:
   """Every module's tip position (steps, modules, 3) in m, each action held ``hold_seconds``.
 
   Raises:
@@ -37,8 +38,12 @@ def tip_trajectory(robot: base.SoftArm, actions: np.ndarray, hold_seconds: float
   return poses.poses(states[0])[..., :3]
 
 
-def equilibrium(robot: base.SoftArm, action: np.ndarray, seconds: float = SETTLE_SECONDS,
-                model: mujoco.MjModel | None = None) -> np.ndarray:
+def equilibrium(
+  robot: base.SoftArm,
+  action: np.ndarray,
+  seconds: float = SETTLE_SECONDS,
+  model: mujoco.MjModel | None = None,
+) -> np.ndarray:
   """Tip positions (modules, 3) in m after holding ``action`` for ``seconds`` from rest."""
   return tip_trajectory(robot, action, seconds, model)[-1]
 
@@ -50,8 +55,9 @@ def full_bend_action(robot: base.SoftArm, module: int) -> np.ndarray:
   return action
 
 
-def tip_axes(robot: base.SoftArm, action: np.ndarray, seconds: float = SETTLE_SECONDS,
-             gravity: bool = True) -> tuple[np.ndarray, np.ndarray]:
+def tip_axes(
+  robot: base.SoftArm, action: np.ndarray, seconds: float = SETTLE_SECONDS, gravity: bool = True
+) -> tuple[np.ndarray, np.ndarray]:
   """Every module's tip axis (modules, 3) at rest and after holding ``action`` for ``seconds``
   from rest, with or without gravity."""
   model = robot.compile()
@@ -71,8 +77,9 @@ def _angles(first: np.ndarray, second: np.ndarray) -> np.ndarray:
   return np.degrees(np.arccos(np.clip(np.sum(first * second, axis=-1), -1.0, 1.0)))
 
 
-def bend_angle(robot: base.SoftArm, action: np.ndarray, module: int = 1,
-               seconds: float = SETTLE_SECONDS) -> float:
+def bend_angle(
+  robot: base.SoftArm, action: np.ndarray, module: int = 1, seconds: float = SETTLE_SECONDS
+) -> float:
   """Angle (deg) between a module's tip axis at rest and after holding ``action``."""
   rest, bent = tip_axes(robot, action, seconds)
   return float(_angles(rest, bent)[module - 1])
@@ -89,8 +96,9 @@ def own_bend_angles(robot: base.SoftArm, seconds: float = SETTLE_SECONDS) -> np.
   return np.array(angles)
 
 
-def gravity_free_tilts(robot: base.SoftArm, module: int,
-                       seconds: float = SETTLE_SECONDS) -> np.ndarray:
+def gravity_free_tilts(
+  robot: base.SoftArm, module: int, seconds: float = SETTLE_SECONDS
+) -> np.ndarray:
   """Angle (deg) of every module's tip axis from rest after holding full actuation of ``module``
   alone, gravity off: how far one module's actuators turn the others."""
   rest, bent = tip_axes(robot, full_bend_action(robot, module), seconds, gravity=False)
@@ -106,14 +114,15 @@ def settling_time(robot: base.SoftArm, seconds: float = SETTLE_SECONDS) -> float
   return 0.0 if len(moving) == 0 else float((moving[-1] + 1) * model.opt.timestep)
 
 
-def workspace_extent(robot: base.SoftArm, seed: int = 0,
-                     samples: int = WORKSPACE_SAMPLES) -> np.ndarray:
+def workspace_extent(
+  robot: base.SoftArm, seed: int = 0, samples: int = WORKSPACE_SAMPLES
+) -> np.ndarray:
   """(3, 2) min and max (m) of the end effector over random actions, each held one control
   period, recorded at the end of every period as in motor babbling."""
   actions = np.random.default_rng(seed).uniform(-1, 1, (samples, robot.action_dim))
   model = robot.compile()
   steps = int(round(robot.control_timestep / model.opt.timestep))
-  tips = tip_trajectory(robot, actions, robot.control_timestep, model)[steps - 1::steps, -1]
+  tips = tip_trajectory(robot, actions, robot.control_timestep, model)[steps - 1 :: steps, -1]
   return np.stack([tips.min(axis=0), tips.max(axis=0)], axis=1)
 
 
@@ -128,12 +137,15 @@ def simulation_speed(robot: base.SoftArm, seconds: float = 5.0, seed: int = 0) -
   start = time.perf_counter()
   rollout.rollout(model, data, initial[None], controls)
   elapsed = time.perf_counter() - start
-  return {"steps_per_second": controls.shape[1] / elapsed,
-          "real_time_factor": controls.shape[1] * model.opt.timestep / elapsed}
+  return {
+    "steps_per_second": controls.shape[1] / elapsed,
+    "real_time_factor": controls.shape[1] * model.opt.timestep / elapsed,
+  }
 
 
-def discretisation_actions(robot: base.SoftArm, seed: int = 0, random_actions: int = 3,
-                           random_scale: float = 0.5) -> np.ndarray:
+def discretisation_actions(
+  robot: base.SoftArm, seed: int = 0, random_actions: int = 3, random_scale: float = 0.5
+) -> np.ndarray:
   """Full bending of each module alone, and a few random actions scaled by ``random_scale``."""
   rng = np.random.default_rng(seed)
   actions = [full_bend_action(robot, k) for k in range(1, robot.num_modules + 1)]
@@ -141,12 +153,19 @@ def discretisation_actions(robot: base.SoftArm, seed: int = 0, random_actions: i
   return np.array(actions)
 
 
-def discretisation_error(robot: base.SoftArm, actions: np.ndarray,
-                         factor: int = DISCRETISATION_REFINEMENT) -> np.ndarray:
+def discretisation_error(
+  robot: base.SoftArm, actions: np.ndarray, factor: int = DISCRETISATION_REFINEMENT
+) -> np.ndarray:
   """End-effector distance (m) at equilibrium between ``robot`` and ``robot.refined(factor)``,
   for each action."""
   finer = robot.refined(factor)
   coarse_model, fine_model = robot.compile(), finer.compile()
-  return np.array([np.linalg.norm(equilibrium(robot, action, model=coarse_model)[-1]
-                                  - equilibrium(finer, action, model=fine_model)[-1])
-                   for action in actions])
+  return np.array(
+    [
+      np.linalg.norm(
+        equilibrium(robot, action, model=coarse_model)[-1]
+        - equilibrium(finer, action, model=fine_model)[-1]
+      )
+      for action in actions
+    ]
+  )

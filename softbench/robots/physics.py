@@ -4,9 +4,9 @@ Everything it needs comes from the MJCF itself (tip sites ``module{k}_tip`` and 
 ``action_map`` numeric), so it drives an exported model file as well as a freshly built robot.
 """
 
+from dm_control import mujoco
 import mujoco as mj
 import numpy as np
-from dm_control import mujoco
 
 from softbench.robots import base
 from softbench.robots import chain
@@ -77,6 +77,9 @@ class SoftArmPhysics(mujoco.Physics):
 
   def module_poses(self) -> np.ndarray:
     """(num_modules, 6): tip position (m) and orientation vector of every module."""
-    return np.stack([np.concatenate([self.module_tip_position(k),
-                                     self.module_orientation_vector(k)])
-                     for k in range(1, self.num_modules + 1)])
+    return np.stack(
+      [
+        np.concatenate([self.module_tip_position(k), self.module_orientation_vector(k)])
+        for k in range(1, self.num_modules + 1)
+      ]
+    )

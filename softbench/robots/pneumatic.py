@@ -28,8 +28,9 @@ _MODULE_RGBA = ((0.90, 0.35, 0.25, 1), (0.35, 0.70, 0.35, 1), (0.25, 0.55, 0.85,
 
 def pressure_to_length_ratio(pressure_kpa: np.ndarray) -> np.ndarray:
   """Bellows length over characteristic length, piecewise linear in pressure (kPa)."""
-  return np.interp(pressure_kpa, [MIN_PRESSURE, 0.0, MAX_PRESSURE],
-                   [MIN_LENGTH_RATIO, 1.0, MAX_LENGTH_RATIO])
+  return np.interp(
+    pressure_kpa, [MIN_PRESSURE, 0.0, MAX_PRESSURE], [MIN_LENGTH_RATIO, 1.0, MAX_LENGTH_RATIO]
+  )
 
 
 def action_to_pressure(action: np.ndarray) -> np.ndarray:
@@ -86,18 +87,30 @@ class PneumaticArm(base.SoftArm):
   faults: tuple[fault_model.Fault, ...] = ()
 
   def __post_init__(self):
-    for field in ("bellows_offset", "bellows_radius", "bellows_stiffness",
-                  "module_mass", "backbone_radius", "backbone_bending_stiffness",
-                  "backbone_axial_stiffness", "timestep", "control_period"):
+    for field in (
+      "bellows_offset",
+      "bellows_radius",
+      "bellows_stiffness",
+      "module_mass",
+      "backbone_radius",
+      "backbone_bending_stiffness",
+      "backbone_axial_stiffness",
+      "timestep",
+      "control_period",
+    ):
       base.check_positive(field, getattr(self, field))
     base.check_module_length(self.module_length)
     if not self.bellows_per_module or any(
-        not isinstance(n, int) or n < 3 for n in self.bellows_per_module):
-      raise ValueError(f"every module needs at least 3 bellows for omnidirectional bending, got "
-                       f"{self.bellows_per_module!r}")
+      not isinstance(n, int) or n < 3 for n in self.bellows_per_module
+    ):
+      raise ValueError(
+        f"every module needs at least 3 bellows for omnidirectional bending, got "
+        f"{self.bellows_per_module!r}"
+      )
     if not isinstance(self.segments_per_module, int) or self.segments_per_module < 1:
-      raise ValueError(f"segments_per_module must be a positive integer, "
-                       f"got {self.segments_per_module!r}")
+      raise ValueError(
+        f"segments_per_module must be a positive integer, got {self.segments_per_module!r}"
+      )
     fault_model.check(self, self.faults)
 
   @property
@@ -156,17 +169,26 @@ class PneumaticArm(base.SoftArm):
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     spec.option.jacobian = mujoco.mjtJacobian.mjJAC_DENSE
     volume = np.pi * self.backbone_radius**2 * self.module_length
-    geometry = chain.ChainGeometry(self.module_lengths, self.segments_per_module,
-                                   self.backbone_radius, self.module_mass / volume)
+    geometry = chain.ChainGeometry(
+      self.module_lengths, self.segments_per_module, self.backbone_radius, self.module_mass / volume
+    )
     joints = chain.SegmentJoints(
-        bending_stiffness=self.backbone_bending_stiffness, ball_damping=self.joint_damping,
-        armature=self.armature,
-        slide_stiffness=self.backbone_axial_stiffness * self.segments_per_module,
-        slide_damping=self.backbone_axial_damping * self.segments_per_module)
+      bending_stiffness=self.backbone_bending_stiffness,
+      ball_damping=self.joint_damping,
+      armature=self.armature,
+      slide_stiffness=self.backbone_axial_stiffness * self.segments_per_module,
+      slide_damping=self.backbone_axial_damping * self.segments_per_module,
+    )
     base_body = spec.worldbody.add_body(name="base")
-    base_body.add_geom(name="base_plate", type=mujoco.mjtGeom.mjGEOM_CYLINDER,
-                       size=(self.bellows_offset + self.bellows_radius, 0.003, 0),
-                       pos=(0, 0, 0.003), rgba=(0.3, 0.3, 0.3, 1), contype=0, conaffinity=0)
+    base_body.add_geom(
+      name="base_plate",
+      type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+      size=(self.bellows_offset + self.bellows_radius, 0.003, 0),
+      pos=(0, 0, 0.003),
+      rgba=(0.3, 0.3, 0.3, 1),
+      contype=0,
+      conaffinity=0,
+    )
     rod = chain.add_chain(base_body, geometry, joints, _MODULE_RGBA, cable_plugin=None)
     self._add_bellows(spec, rod)
 
@@ -174,8 +196,10 @@ class PneumaticArm(base.SoftArm):
     """Each bellows: a tendon through sites at every segment midpoint of its module, from the
     module's base plate to its tip plate, driven by a position actuator on its length whose
     control is the change of rest length: force = k (L0 + ctrl - length) - c · velocity."""
-    lengths = [m.at_minus_one for m in self.actuator_maps()], [m.at_plus_one
-                                                                for m in self.actuator_maps()]
+    lengths = (
+      [m.at_minus_one for m in self.actuator_maps()],
+      [m.at_plus_one for m in self.actuator_maps()],
+    )
     index = 0
     for module in range(1, self.num_modules + 1):
       start = rod.geometry.module_start(module)
@@ -184,18 +208,30 @@ class PneumaticArm(base.SoftArm):
       rgba = chain.module_rgba(_MODULE_RGBA, module)
       for bellows, offset in enumerate(offsets, start=1):
         name = f"module{module}_bellows{bellows}"
-        tendon = spec.add_tendon(name=name, width=self.bellows_radius * 0.5,
-                                 rgba=(*rgba[:3], 0.6))
+        tendon = spec.add_tendon(name=name, width=self.bellows_radius * 0.5, rgba=(*rgba[:3], 0.6))
         for point in range(self.segments_per_module + 1):
-          site = rod.add_site(f"{name}_site{point}", start + point * spacing, offset,
-                              size=(0.002, 0, 0), rgba=(0.2, 0.2, 0.2, 1))
+          site = rod.add_site(
+            f"{name}_site{point}",
+            start + point * spacing,
+            offset,
+            size=(0.002, 0, 0),
+            rgba=(0.2, 0.2, 0.2, 1),
+          )
           tendon.wrap_site(site.name)
         spec.add_actuator(
-            name=name, trntype=mujoco.mjtTrn.mjTRN_TENDON, target=name,
-            gaintype=mujoco.mjtGain.mjGAIN_FIXED, biastype=mujoco.mjtBias.mjBIAS_AFFINE,
-            gainprm=[self.bellows_stiffness] + [0] * 9,
-            biasprm=[self.bellows_stiffness * self.module_length, -self.bellows_stiffness,
-                     -self.bellows_damping] + [0] * 7,
-            ctrllimited=mujoco.mjtLimited.mjLIMITED_TRUE,
-            ctrlrange=(lengths[0][index], lengths[1][index]))
+          name=name,
+          trntype=mujoco.mjtTrn.mjTRN_TENDON,
+          target=name,
+          gaintype=mujoco.mjtGain.mjGAIN_FIXED,
+          biastype=mujoco.mjtBias.mjBIAS_AFFINE,
+          gainprm=[self.bellows_stiffness] + [0] * 9,
+          biasprm=[
+            self.bellows_stiffness * self.module_length,
+            -self.bellows_stiffness,
+            -self.bellows_damping,
+          ]
+          + [0] * 7,
+          ctrllimited=mujoco.mjtLimited.mjLIMITED_TRUE,
+          ctrlrange=(lengths[0][index], lengths[1][index]),
+        )
         index += 1

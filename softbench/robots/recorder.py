@@ -10,8 +10,8 @@ physics state reproduces uninterrupted stepping bit for bit (``mj_step`` with th
 from typing import Callable
 
 import mujoco
-import numpy as np
 from mujoco import rollout
+import numpy as np
 
 from softbench.robots import base
 from softbench.robots import chain
@@ -23,8 +23,7 @@ STATE_SPEC = mujoco.mjtState.mjSTATE_FULLPHYSICS
 class PoseRecorder:
   """Records module poses of ``robot`` under held actions, on ``workers`` threads."""
 
-  def __init__(self, robot: base.SoftArm, workers: int = 1,
-               model: mujoco.MjModel | None = None):
+  def __init__(self, robot: base.SoftArm, workers: int = 1, model: mujoco.MjModel | None = None):
     """``model``: the robot's compiled model to simulate (default ``robot.compile()``), e.g. a
     copy of an environment's, which a model-based agent plans on."""
     if workers < 1:
@@ -37,8 +36,9 @@ class PoseRecorder:
     self._action_map = self.model.numeric(base.ACTION_MAP_NAME).data.reshape(-1, 4).copy()
     self._data = [mujoco.MjData(self.model) for _ in range(workers)]
     self._scratch = mujoco.MjData(self.model)
-    self._sites = [self.model.site(chain.tip_site_name(k)).id
-                   for k in range(1, robot.num_modules + 1)]
+    self._sites = [
+      self.model.site(chain.tip_site_name(k)).id for k in range(1, robot.num_modules + 1)
+    ]
 
   @property
   def state_size(self) -> int:
@@ -69,8 +69,12 @@ class PoseRecorder:
     if diverged or not np.all(np.isfinite(states)):
       raise FloatingPointError(f"{self.robot.name}: simulation unstable at control step {step}")
 
-  def record(self, actions: np.ndarray, initial_states: np.ndarray | None = None,
-             on_step: Callable[[int], None] | None = None) -> tuple[np.ndarray, np.ndarray]:
+  def record(
+    self,
+    actions: np.ndarray,
+    initial_states: np.ndarray | None = None,
+    on_step: Callable[[int], None] | None = None,
+  ) -> tuple[np.ndarray, np.ndarray]:
     """Holds each action for one control period, episode by episode in parallel.
 
     Args:
@@ -88,8 +92,9 @@ class PoseRecorder:
     """
     actions = np.asarray(actions, dtype=float)
     if actions.ndim != 3 or actions.shape[2] != self.robot.action_dim:
-      raise ValueError(f"actions must be (episodes, steps, {self.robot.action_dim}), "
-                       f"got {actions.shape}")
+      raise ValueError(
+        f"actions must be (episodes, steps, {self.robot.action_dim}), got {actions.shape}"
+      )
     if not np.all(np.isfinite(actions)) or np.any(np.abs(actions) > 1.0):
       raise ValueError("actions must be finite and lie in [-1, 1]")
     episodes, steps = actions.shape[:2]
@@ -103,8 +108,14 @@ class PoseRecorder:
     buffer = np.empty((episodes, self.steps_per_action, self.state_size))
     with rollout.Rollout(nthread=self.workers) as runner:
       for step in range(steps):
-        runner.rollout([self.model] * episodes, self._data, states, controls[:, step, None],
-                       nstep=self.steps_per_action, state=buffer)
+        runner.rollout(
+          [self.model] * episodes,
+          self._data,
+          states,
+          controls[:, step, None],
+          nstep=self.steps_per_action,
+          state=buffer,
+        )
         states = buffer[:, -1].copy()
         self._check_stable(states, step)
         poses[:, step + 1] = self.poses(states)

@@ -1,4 +1,4 @@
-"""``tendon-N``: a modular tendon-driven soft arm whose cables cross the proximal modules (SPEC 2.1).
+"""``tendon-N``: a modular tendon-driven soft arm, cables crossing the proximal modules (SPEC 2.1).
 
 N modules of 50 mm hang from a fixed base under gravity. The backbone is a silicone rod cut into
 rigid segments whose elasticity comes from MuJoCo's ``mujoco.elasticity.cable`` plugin (the
@@ -34,10 +34,19 @@ MODULE_LENGTH = 0.05  # (m) Paper: "Each module has a length of 50 mm".
 MAX_MODULES = 10  # Largest N that builds; N = 1 .. 5 are the benchmark configurations.
 BACKBONES = ("cable", "joints")
 # Cables, as (name, angle around the arm in degrees, action axis, sign of the action that pulls it).
-_CABLES = (("xpos", 0.0, 0, +1), ("ypos", 90.0, 1, +1), ("xneg", 180.0, 0, -1),
-           ("yneg", 270.0, 1, -1))
-_MODULE_RGBA = ((0.90, 0.35, 0.25, 1), (0.95, 0.70, 0.20, 1), (0.35, 0.70, 0.35, 1),
-                (0.25, 0.55, 0.85, 1), (0.55, 0.40, 0.80, 1))
+_CABLES = (
+  ("xpos", 0.0, 0, +1),
+  ("ypos", 90.0, 1, +1),
+  ("xneg", 180.0, 0, -1),
+  ("yneg", 270.0, 1, -1),
+)
+_MODULE_RGBA = (
+  (0.90, 0.35, 0.25, 1),
+  (0.95, 0.70, 0.20, 1),
+  (0.35, 0.70, 0.35, 1),
+  (0.25, 0.55, 0.85, 1),
+  (0.55, 0.40, 0.80, 1),
+)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -94,17 +103,30 @@ class CableDrivenArm(base.SoftArm):
   _POSITIVE_FIELDS: ClassVar[tuple[str, ...]] = ()  # A family's own fields that must be > 0.
 
   def __post_init__(self):
-    if (isinstance(self.num_modules, bool) or not isinstance(self.num_modules, int)
-        or not 1 <= self.num_modules <= MAX_MODULES):
-      raise ValueError(f"{self.FAMILY} arms have 1 to {MAX_MODULES} modules, "
-                       f"got {self.num_modules!r}")
+    if (
+      isinstance(self.num_modules, bool)
+      or not isinstance(self.num_modules, int)
+      or not 1 <= self.num_modules <= MAX_MODULES
+    ):
+      raise ValueError(
+        f"{self.FAMILY} arms have 1 to {MAX_MODULES} modules, got {self.num_modules!r}"
+      )
     if not isinstance(self.segments_per_module, int) or self.segments_per_module < 1:
-      raise ValueError(f"segments_per_module must be a positive integer, "
-                       f"got {self.segments_per_module!r}")
+      raise ValueError(
+        f"segments_per_module must be a positive integer, got {self.segments_per_module!r}"
+      )
     if not 0 < self.hole_inset < 0.5:
       raise ValueError(f"hole_inset must lie strictly between 0 and 0.5, got {self.hole_inset!r}")
-    for field in ("radius", "youngs_modulus", "density", "cable_offset", "max_tension",
-                  "timestep", "control_period", *self._POSITIVE_FIELDS):
+    for field in (
+      "radius",
+      "youngs_modulus",
+      "density",
+      "cable_offset",
+      "max_tension",
+      "timestep",
+      "control_period",
+      *self._POSITIVE_FIELDS,
+    ):
       base.check_positive(field, getattr(self, field))
     base.check_module_length(self.module_length)
     for field in ("damping", "medium_viscosity", "armature"):
@@ -122,8 +144,10 @@ class CableDrivenArm(base.SoftArm):
     # Canonical names only: ASCII digits, no leading zero, no surrounding space.
     match = re.fullmatch(rf"{re.escape(cls.FAMILY)}-(0|[1-9][0-9]{{0,3}})", name, re.ASCII)
     if not match:
-      raise ValueError(f"malformed {cls.FAMILY} arm name {name[:40]!r}; expected "
-                       f"{cls.FAMILY}-N with N from 1 to {MAX_MODULES}")
+      raise ValueError(
+        f"malformed {cls.FAMILY} arm name {name[:40]!r}; expected "
+        f"{cls.FAMILY}-N with N from 1 to {MAX_MODULES}"
+      )
     if "num_modules" in overrides:
       raise ValueError(f"{name!r} names its number of modules; drop num_modules")
     return cls(num_modules=int(match.group(1)), **overrides)
@@ -186,25 +210,37 @@ class CableDrivenArm(base.SoftArm):
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER
     # A chain's mass matrix is dense whatever its length; dense Jacobians measured 25% faster.
     spec.option.jacobian = mujoco.mjtJacobian.mjJAC_DENSE
-    geometry = chain.ChainGeometry(self.module_lengths, self.segments_per_module, self.radius,
-                                   self.density)
+    geometry = chain.ChainGeometry(
+      self.module_lengths, self.segments_per_module, self.radius, self.density
+    )
     if self.backbone == "cable":
       spec.activate_plugin(chain.CABLE_PLUGIN)
-      plugin = spec.add_plugin(name="backbone_elasticity", plugin_name=chain.CABLE_PLUGIN,
-                               active=True)
+      plugin = spec.add_plugin(
+        name="backbone_elasticity", plugin_name=chain.CABLE_PLUGIN, active=True
+      )
       torsion_modulus = self.youngs_modulus / (2 * (1 + self.poisson_ratio))
-      plugin.config = {"twist": repr(torsion_modulus), "bend": repr(self.youngs_modulus),
-                       "vmax": "0"}
+      plugin.config = {
+        "twist": repr(torsion_modulus),
+        "bend": repr(self.youngs_modulus),
+        "vmax": "0",
+      }
       joint_bending_stiffness = 0.0
     else:
       plugin = None
       joint_bending_stiffness = self.bending_stiffness
-    joints = chain.SegmentJoints(bending_stiffness=joint_bending_stiffness,
-                                 ball_damping=self.damping, armature=self.armature)
+    joints = chain.SegmentJoints(
+      bending_stiffness=joint_bending_stiffness, ball_damping=self.damping, armature=self.armature
+    )
     base_body = spec.worldbody.add_body(name="base")
-    base_body.add_geom(name="base_plate", type=mujoco.mjtGeom.mjGEOM_CYLINDER,
-                       size=(self.cable_offset * 2, 0.002, 0), pos=(0, 0, 0.002),
-                       rgba=(0.3, 0.3, 0.3, 1), contype=0, conaffinity=0)
+    base_body.add_geom(
+      name="base_plate",
+      type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+      size=(self.cable_offset * 2, 0.002, 0),
+      pos=(0, 0, 0.002),
+      rgba=(0.3, 0.3, 0.3, 1),
+      contype=0,
+      conaffinity=0,
+    )
     rod = chain.add_chain(base_body, geometry, joints, _MODULE_RGBA, plugin)
     self._add_cables(spec, rod)
 
@@ -225,24 +261,36 @@ class CableDrivenArm(base.SoftArm):
       rgba = chain.module_rgba(_MODULE_RGBA, module)
       route = self.cable_route(rod, module)
       for cable, (cable_name, *_) in enumerate(_CABLES):
-        tendon = spec.add_tendon(name=f"module{module}_cable_{cable_name}", width=0.0005,
-                                 rgba=rgba)
+        tendon = spec.add_tendon(name=f"module{module}_cable_{cable_name}", width=0.0005, rgba=rgba)
         for label, arc_length, offset in route:
           site = f"{label}_{cable_name}"
           if site not in added:
             added.add(site)
-            rod.add_site(site, arc_length, chain.ring_offsets(offset, angles)[cable],
-                         size=(0.0006, 0, 0), rgba=(0.2, 0.2, 0.2, 1))
+            rod.add_site(
+              site,
+              arc_length,
+              chain.ring_offsets(offset, angles)[cable],
+              size=(0.0006, 0, 0),
+              rgba=(0.2, 0.2, 0.2, 1),
+            )
           tendon.wrap_site(site)
         anchor = f"module{module}_anchor_{cable_name}"
-        rod.add_site(anchor, tip, chain.ring_offsets(self.cable_offset, angles)[cable],
-                     size=(0.0009, 0, 0), rgba=(0.1, 0.1, 0.1, 1))
+        rod.add_site(
+          anchor,
+          tip,
+          chain.ring_offsets(self.cable_offset, angles)[cable],
+          size=(0.0009, 0, 0),
+          rgba=(0.1, 0.1, 0.1, 1),
+        )
         tendon.wrap_site(anchor)
         spec.add_actuator(
-            name=f"module{module}_cable_{cable_name}",
-            trntype=mujoco.mjtTrn.mjTRN_TENDON, target=tendon.name,
-            gear=(-1, 0, 0, 0, 0, 0),  # Cables pull: positive control shortens the tendon.
-            ctrllimited=mujoco.mjtLimited.mjLIMITED_TRUE, ctrlrange=(0, self.max_tension))
+          name=f"module{module}_cable_{cable_name}",
+          trntype=mujoco.mjtTrn.mjTRN_TENDON,
+          target=tendon.name,
+          gear=(-1, 0, 0, 0, 0, 0),  # Cables pull: positive control shortens the tendon.
+          ctrllimited=mujoco.mjtLimited.mjLIMITED_TRUE,
+          ctrlrange=(0, self.max_tension),
+        )
 
 
 @dataclasses.dataclass(frozen=True)
@@ -268,6 +316,11 @@ class TendonArm(CableDrivenArm):
     route = []
     for prefix, arc_length in rod.channel_holes(self.hole_inset, end=tip):
       own = arc_length >= start or module == 1
-      route.append((f"{prefix}_{'outer' if own else 'inner'}_hole", arc_length,
-                    self.cable_offset if own else self.pass_through_offset))
+      route.append(
+        (
+          f"{prefix}_{'outer' if own else 'inner'}_hole",
+          arc_length,
+          self.cable_offset if own else self.pass_through_offset,
+        )
+      )
     return route

@@ -10,8 +10,8 @@ loads at the module's two ends; modules couple only through the shared rod (a di
 on the proximal ones), gravity and the medium's drag. With gravity off, pulling a cable of module
 k leaves modules 1 .. k-1 straight, where on ``tendon-N`` it bends them too. Inside its own module
 a cable runs 6 mm from the axis, as on ``tendon-N``, so the same Tmax (2.58 N) bends a module by
-the same angle relative to its base (measured in both families' model READMEs), and ``tendon-local-1`` has the physics
-of ``tendon-1``.
+the same angle relative to its base (measured in both families' model READMEs), and
+``tendon-local-1`` has the physics of ``tendon-1``.
 
 Action: two values per module in [-1, 1], as on ``tendon-N``: value a of axis x pulls the +x cable
 with tension max(0, a)·Tmax and the -x cable with max(0, -a)·Tmax; likewise for y.
@@ -37,5 +37,7 @@ class LocalTendonArm(tendon.CableDrivenArm):
     boundary falls at a body's midpoint), so the cable's pull starts there; a cable's stretch
     within one body adds no load."""
     start, tip = rod.geometry.module_start(module), rod.geometry.module_start(module + 1)
-    return [(f"{prefix}_hole", arc_length, self.cable_offset)
-            for prefix, arc_length in rod.channel_holes(self.hole_inset, start=start, end=tip)]
+    return [
+      (f"{prefix}_hole", arc_length, self.cable_offset)
+      for prefix, arc_length in rod.channel_holes(self.hole_inset, start=start, end=tip)
+    ]

@@ -15,8 +15,8 @@ import collections
 import inspect
 from typing import Callable
 
-import numpy as np
 from dm_control.rl import control
+import numpy as np
 
 from softbench import robots
 from softbench.data import seeding
@@ -28,46 +28,89 @@ from softbench.suite import tracking
 from softbench.suite import trajectories
 
 TaskEntry = collections.namedtuple(
-    "TaskEntry", ["build", "tags", "description", "paper_robot", "length_option"])
+  "TaskEntry", ["build", "tags", "description", "paper_robot", "length_option"]
+)
 """A task of the suite: ``build(robot, random=..., **options)``, its tags, a one-line description,
 the robot it runs on in the paper (the default of ``softbench run --robot``) and the option that
 sets its episode length (None: the user's trajectory does)."""
 
 
 def _reference_task(shape: str) -> Callable[..., base.SoftArmTask]:
-  def build(robot, length: int = references.REFERENCE_LENGTH,
-            initial_actuation: float = base.INITIAL_ACTUATION, random=None) -> base.SoftArmTask:
-    return tracking.Tracking(robot, references.reference(robot, shape, length).targets,
-                             initial_actuation=initial_actuation, random=random)
+  def build(
+    robot,
+    length: int = references.REFERENCE_LENGTH,
+    initial_actuation: float = base.INITIAL_ACTUATION,
+    random=None,
+  ) -> base.SoftArmTask:
+    return tracking.Tracking(
+      robot,
+      references.reference(robot, shape, length).targets,
+      initial_actuation=initial_actuation,
+      random=random,
+    )
+
   return build
 
 
-def _custom_task(robot, trajectory=None, initial_actuation: float = base.INITIAL_ACTUATION,
-                 random=None) -> base.SoftArmTask:
+def _custom_task(
+  robot, trajectory=None, initial_actuation: float = base.INITIAL_ACTUATION, random=None
+) -> base.SoftArmTask:
   if trajectory is None:
-    raise ValueError("task 'custom' needs a trajectory (trajectory=ARRAY_OR_PATH, or "
-                     "--trajectory FILE)")
-  return tracking.Tracking(robot, trajectories.load_trajectory(trajectory, robot),
-                           initial_actuation=initial_actuation, random=random)
+    raise ValueError(
+      "task 'custom' needs a trajectory (trajectory=ARRAY_OR_PATH, or --trajectory FILE)"
+    )
+  return tracking.Tracking(
+    robot,
+    trajectories.load_trajectory(trajectory, robot),
+    initial_actuation=initial_actuation,
+    random=random,
+  )
 
 
 # The paper runs its Exp2S tracking on the tendon arm and its reaching on the pneumatic arm.
 _TASKS = {
-    "babbling": TaskEntry(_reference_task("babbling"), ("benchmarking", "tracking"),
-                          "follow held-out poses produced by random actuation", "tendon-3",
-                          "length"),
-    "circle": TaskEntry(_reference_task("circle"), ("benchmarking", "tracking"),
-                        "follow a circle traced in actuation space", "tendon-3", "length"),
-    "rectangle": TaskEntry(_reference_task("rectangle"), ("benchmarking", "tracking"),
-                           "follow a rectangle traced in actuation space", "tendon-3", "length"),
-    "spiral": TaskEntry(_reference_task("spiral"), ("benchmarking", "tracking"),
-                        "follow a growing spiral traced in actuation space", "tendon-3", "length"),
-    "reach": TaskEntry(reach.Reach, ("benchmarking",),
-                       "bring one module's tip to a virtual point (position only)",
-                       "pneumatic-433", "steps"),
-    "custom": TaskEntry(_custom_task, ("tracking", "user"),
-                        "follow your own trajectory (.npy or .csv, one target per row)",
-                        "tendon-3", None),
+  "babbling": TaskEntry(
+    _reference_task("babbling"),
+    ("benchmarking", "tracking"),
+    "follow held-out poses produced by random actuation",
+    "tendon-3",
+    "length",
+  ),
+  "circle": TaskEntry(
+    _reference_task("circle"),
+    ("benchmarking", "tracking"),
+    "follow a circle traced in actuation space",
+    "tendon-3",
+    "length",
+  ),
+  "rectangle": TaskEntry(
+    _reference_task("rectangle"),
+    ("benchmarking", "tracking"),
+    "follow a rectangle traced in actuation space",
+    "tendon-3",
+    "length",
+  ),
+  "spiral": TaskEntry(
+    _reference_task("spiral"),
+    ("benchmarking", "tracking"),
+    "follow a growing spiral traced in actuation space",
+    "tendon-3",
+    "length",
+  ),
+  "reach": TaskEntry(
+    reach.Reach,
+    ("benchmarking",),
+    "bring one module's tip to a virtual point (position only)",
+    "pneumatic-433",
+    "steps",
+  ),
+  "custom": TaskEntry(
+    _custom_task,
+    ("tracking", "user"),
+    "follow your own trajectory (.npy or .csv, one target per row)",
+    "tendon-3",
+    None,
+  ),
 }
 TASKS = tuple(_TASKS)
 
@@ -75,8 +118,12 @@ TASKS = tuple(_TASKS)
 def _pairs() -> tuple[tuple[tuple[str, str], ...], tuple[tuple[str, str], ...]]:
   """Every (robot, task) pair of the benchmark robots and the tasks that need no user input, and
   those of them tagged ``benchmarking``."""
-  every = tuple((robot, task) for robot in robots.BENCHMARK_ROBOTS for task in TASKS
-                if "user" not in _TASKS[task].tags)
+  every = tuple(
+    (robot, task)
+    for robot in robots.BENCHMARK_ROBOTS
+    for task in TASKS
+    if "user" not in _TASKS[task].tags
+  )
   return every, tuple(pair for pair in every if "benchmarking" in _TASKS[pair[1]].tags)
 
 
@@ -114,8 +161,13 @@ def length_options(task: str, steps: int | None) -> dict:
   return {} if steps is None or option is None else {option: steps}
 
 
-def load(robot: str | robots.SoftArm, task: str, seed=None, environment_kwargs: dict | None = None,
-         **task_kwargs) -> control.Environment:
+def load(
+  robot: str | robots.SoftArm,
+  task: str,
+  seed=None,
+  environment_kwargs: dict | None = None,
+  **task_kwargs,
+) -> control.Environment:
   """The environment of ``task`` on ``robot`` (a name such as ``tendon-3``, or a robot spec).
 
   The physics is ``robot``'s, faults included (``robot.with_faults``); the targets are those of
@@ -140,16 +192,26 @@ def load(robot: str | robots.SoftArm, task: str, seed=None, environment_kwargs: 
   options = set(inspect.signature(entry.build).parameters) - {"robot", "random"}
   unknown = sorted(set(task_kwargs) - options)
   if unknown:
-    raise ValueError(f"task {task!r} has no option {unknown[0]!r}; its options: "
-                     f"{', '.join(sorted(options))}")
+    raise ValueError(
+      f"task {task!r} has no option {unknown[0]!r}; its options: {', '.join(sorted(options))}"
+    )
   if seed is not None and not isinstance(seed, np.random.RandomState):
     seeding.check_seed(seed)
   # Targets come from the robot as designed: an actuator fault changes the physics, not the task.
   built = entry.build(arm.without_faults(), random=seed, **task_kwargs)
   physics = arm_physics.SoftArmPhysics.from_robot(arm)
-  return control.Environment(physics, built, control_timestep=arm.control_timestep,
-                             **(environment_kwargs or {}))
+  return control.Environment(
+    physics, built, control_timestep=arm.control_timestep, **(environment_kwargs or {})
+  )
 
 
-__all__ = ["ALL_TASKS", "BENCHMARKING", "TASKS", "TaskEntry", "describe", "length_options", "load",
-           "register"]
+__all__ = [
+  "ALL_TASKS",
+  "BENCHMARKING",
+  "TASKS",
+  "TaskEntry",
+  "describe",
+  "length_options",
+  "load",
+  "register",
+]

@@ -7,10 +7,10 @@ step t (``target``); the reward after step t scores the pose reached against tha
 
 import collections
 
-import numpy as np
 from dm_control.suite import base as suite_base
 from dm_control.utils import rewards
 from dm_env import specs
+import numpy as np
 
 from softbench.robots import base
 from softbench.robots import physics as arm_physics
@@ -31,8 +31,9 @@ class SoftArmTask(suite_base.Task):
   action is the first ``previous_action`` observation.
   """
 
-  def __init__(self, robot: base.SoftArm, initial_actuation: float = INITIAL_ACTUATION,
-               random=None):
+  def __init__(
+    self, robot: base.SoftArm, initial_actuation: float = INITIAL_ACTUATION, random=None
+  ):
     if not 0.0 <= initial_actuation <= 1.0:
       raise ValueError(f"initial_actuation must lie in [0, 1], got {initial_actuation}")
     super().__init__(random=random)
@@ -89,10 +90,12 @@ class SoftArmTask(suite_base.Task):
   def observation_spec(self, physics: arm_physics.SoftArmPhysics) -> collections.OrderedDict:
     modules = (len(self.scored_modules()), self.target_size)
     return collections.OrderedDict(
-        poses=specs.Array((physics.num_modules, 6), np.float64, name="poses"),
-        target=specs.Array(modules, np.float64, name="target"),
-        previous_action=specs.BoundedArray((physics.action_dim,), np.float64, -1.0, 1.0,
-                                           name="previous_action"))
+      poses=specs.Array((physics.num_modules, 6), np.float64, name="poses"),
+      target=specs.Array(modules, np.float64, name="target"),
+      previous_action=specs.BoundedArray(
+        (physics.action_dim,), np.float64, -1.0, 1.0, name="previous_action"
+      ),
+    )
 
   def get_termination(self, physics: arm_physics.SoftArmPhysics) -> float | None:
     return 1.0 if self._step >= self.num_steps else None
@@ -109,5 +112,13 @@ class SoftArmTask(suite_base.Task):
     achieved = physics.module_poses()[np.array(self.scored_modules()) - 1, :3]
     distance = np.linalg.norm(achieved - self.targets_at(self._step - 1)[:, :3], axis=-1)
     length = self.robot.length
-    return float(np.mean(rewards.tolerance(distance, bounds=(0.0, REWARD_TOLERANCE * length),
-                                           margin=REWARD_MARGIN * length, sigmoid="long_tail")))
+    return float(
+      np.mean(
+        rewards.tolerance(
+          distance,
+          bounds=(0.0, REWARD_TOLERANCE * length),
+          margin=REWARD_MARGIN * length,
+          sigmoid="long_tail",
+        )
+      )
+    )

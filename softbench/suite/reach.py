@@ -35,9 +35,14 @@ class Reach(base.SoftArmTask):
 
   target_size = 3
 
-  def __init__(self, robot: robot_base.SoftArm, module: int | None = None,
-               steps: int | None = None, initial_actuation: float = base.INITIAL_ACTUATION,
-               random=None):
+  def __init__(
+    self,
+    robot: robot_base.SoftArm,
+    module: int | None = None,
+    steps: int | None = None,
+    initial_actuation: float = base.INITIAL_ACTUATION,
+    random=None,
+  ):
     super().__init__(robot, initial_actuation, random)
     module = check_module(robot, module)
     default_steps = int(round(REACH_SECONDS / robot.control_timestep))

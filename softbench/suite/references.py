@@ -17,12 +17,12 @@ one is reported (``CorruptFileWarning``) and generated again. The generating act
 for replay checks; tasks show controllers only the poses.
 """
 
+from collections.abc import Callable
 import dataclasses
 import functools
 import hashlib
 import json
 import os
-from collections.abc import Callable
 
 import numpy as np
 
@@ -57,12 +57,14 @@ def _on_circle(radius: np.ndarray | float, phase: np.ndarray) -> np.ndarray:
 
 def _on_rectangle(phase: np.ndarray) -> np.ndarray:
   half_x, half_y = RECTANGLE_HALF_SIDES
-  corners = np.array([[half_x, -half_y], [half_x, half_y], [-half_x, half_y], [-half_x, -half_y],
-                      [half_x, -half_y]])
+  corners = np.array(
+    [[half_x, -half_y], [half_x, half_y], [-half_x, half_y], [-half_x, -half_y], [half_x, -half_y]]
+  )
   distance = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(corners, axis=0), axis=1))])
   along = (phase % 1.0) * distance[-1]
-  return np.stack([np.interp(along, distance, corners[:, 0]),
-                   np.interp(along, distance, corners[:, 1])], axis=-1)
+  return np.stack(
+    [np.interp(along, distance, corners[:, 0]), np.interp(along, distance, corners[:, 1])], axis=-1
+  )
 
 
 @functools.lru_cache(maxsize=None)
@@ -81,7 +83,9 @@ def bend_amplitude(robot: base.SoftArm) -> float:
   first = reached[0]
   if first == 0:
     return float(AMPLITUDE_GRID[0])
-  return float(np.interp(BEND_DEG, bends[first - 1:first + 1], AMPLITUDE_GRID[first - 1:first + 1]))
+  return float(
+    np.interp(BEND_DEG, bends[first - 1 : first + 1], AMPLITUDE_GRID[first - 1 : first + 1])
+  )
 
 
 def _lead_in(length: int) -> np.ndarray:
@@ -103,9 +107,11 @@ def _spiral(length: int) -> np.ndarray:
 
 def _planar(path: Callable[[int], np.ndarray]) -> Callable[..., np.ndarray]:
   """The actions of a path (length, 2) in the planar actuation space, in bend amplitudes."""
+
   def actions(robot: base.SoftArm, length: int, amplitude: float | None) -> np.ndarray:
     amplitude = bend_amplitude(robot) if amplitude is None else amplitude
     return robot.planar_action(amplitude * path(length))
+
   return actions
 
 
@@ -115,8 +121,12 @@ def _babbling(robot: base.SoftArm, length: int, amplitude: float | None) -> np.n
   return stream.uniform(-1.0, 1.0, (length, robot.action_dim))
 
 
-_GENERATORS = {"babbling": _babbling, "circle": _planar(_circle),
-               "rectangle": _planar(_rectangle), "spiral": _planar(_spiral)}
+_GENERATORS = {
+  "babbling": _babbling,
+  "circle": _planar(_circle),
+  "rectangle": _planar(_rectangle),
+  "spiral": _planar(_spiral),
+}
 """Shape name -> ``generate(robot, length, amplitude) -> actions (length, action_dim)``; a new
 shape is a generator and one entry here."""
 SHAPES = tuple(_GENERATORS)
@@ -127,8 +137,9 @@ def _check_shape(shape: str) -> None:
     raise ValueError(f"unknown reference shape {shape!r}; choose one of {', '.join(SHAPES)}")
 
 
-def pattern_actions(robot: base.SoftArm, shape: str, length: int = REFERENCE_LENGTH,
-                    amplitude: float | None = None) -> np.ndarray:
+def pattern_actions(
+  robot: base.SoftArm, shape: str, length: int = REFERENCE_LENGTH, amplitude: float | None = None
+) -> np.ndarray:
   """The generating actions (length, action_dim) of reference ``shape``; ``amplitude`` is
   ``bend_amplitude(robot)`` unless given."""
   _check_shape(shape)
@@ -151,11 +162,19 @@ class Reference:
 
 
 def _config(robot: base.SoftArm, shape: str, length: int) -> dict:
-  return {"format": FORMAT_VERSION, "robot": robot.name, "shape": shape, "length": length,
-          "robot_xml_sha256": hashlib.sha256(robot.to_xml().encode()).hexdigest(),
-          "bend_deg": BEND_DEG, "amplitude_grid": AMPLITUDE_GRID.tolist(), "lead_in": LEAD_IN,
-          "circle": [CIRCLE_RADIUS, CIRCLE_TURNS],
-          "rectangle": [*RECTANGLE_HALF_SIDES, RECTANGLE_LAPS], "spiral": [SPIRAL_TURNS]}
+  return {
+    "format": FORMAT_VERSION,
+    "robot": robot.name,
+    "shape": shape,
+    "length": length,
+    "robot_xml_sha256": hashlib.sha256(robot.to_xml().encode()).hexdigest(),
+    "bend_deg": BEND_DEG,
+    "amplitude_grid": AMPLITUDE_GRID.tolist(),
+    "lead_in": LEAD_IN,
+    "circle": [CIRCLE_RADIUS, CIRCLE_TURNS],
+    "rectangle": [*RECTANGLE_HALF_SIDES, RECTANGLE_LAPS],
+    "spiral": [SPIRAL_TURNS],
+  }
 
 
 def _load_cached(path, config: dict) -> Reference | None:
@@ -196,7 +215,9 @@ def reference(robot: base.SoftArm, shape: str, length: int = REFERENCE_LENGTH) -
   poses, _ = recorder.PoseRecorder(robot).record(actions[None])
   arrays = {"actions": actions, "poses": poses[0]}
   storage.write_cache_file(path, storage.npz_bytes(arrays), "cached reference")
-  storage.write_cache_file(path.with_suffix(".json"), json.dumps(
-      {"config": config, "sha256": storage.arrays_sha256(arrays)}, indent=2) + "\n",
-                           "cached reference's description")
+  storage.write_cache_file(
+    path.with_suffix(".json"),
+    json.dumps({"config": config, "sha256": storage.arrays_sha256(arrays)}, indent=2) + "\n",
+    "cached reference's description",
+  )
   return Reference(shape, actions, poses[0])

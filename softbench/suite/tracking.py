@@ -13,8 +13,13 @@ from softbench.suite import base
 class Tracking(base.SoftArmTask):
   """Follow ``targets`` (steps, num_modules, 6) with every module."""
 
-  def __init__(self, robot: robot_base.SoftArm, targets: np.ndarray,
-               initial_actuation: float = base.INITIAL_ACTUATION, random=None):
+  def __init__(
+    self,
+    robot: robot_base.SoftArm,
+    targets: np.ndarray,
+    initial_actuation: float = base.INITIAL_ACTUATION,
+    random=None,
+  ):
     super().__init__(robot, initial_actuation, random)
     targets = np.asarray(targets, dtype=float)
     if targets.ndim != 3 or targets.shape[1:] != (robot.num_modules, 6) or len(targets) == 0:

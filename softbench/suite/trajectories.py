@@ -44,8 +44,10 @@ def load_trajectory(source, robot: base.SoftArm) -> np.ndarray:
       orientation vectors that are not unit length.
   """
   modules = robot.num_modules
-  expected = (f"(steps, {6 * modules}): per row, each of the {modules} module(s)' tip position "
-              f"(m) and unit orientation vector")
+  expected = (
+    f"(steps, {6 * modules}): per row, each of the {modules} module(s)' tip position "
+    f"(m) and unit orientation vector"
+  )
   if isinstance(source, (str, pathlib.Path)):
     array = _read(pathlib.Path(source))
   else:
@@ -73,7 +75,9 @@ def load_trajectory(source, robot: base.SoftArm) -> np.ndarray:
   limit = REACH_FACTOR * robot.length
   far = np.abs(targets[..., :3]).max(axis=(1, 2)) > limit
   if np.any(far):
-    raise ValueError(f"trajectory row {int(np.argmax(far))}: a target position lies more than "
-                     f"{limit * 1000:.0f} mm ({REACH_FACTOR:g} arm lengths) from the base of "
-                     f"{robot.name}; positions are in m")
+    raise ValueError(
+      f"trajectory row {int(np.argmax(far))}: a target position lies more than "
+      f"{limit * 1000:.0f} mm ({REACH_FACTOR:g} arm lengths) from the base of "
+      f"{robot.name}; positions are in m"
+    )
   return targets

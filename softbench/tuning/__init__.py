@@ -17,5 +17,14 @@ from softbench.tuning.study import settings
 from softbench.tuning.study import summary_path
 from softbench.tuning.study import write_summary
 
-__all__ = ["DEFAULT_TRIALS", "TuneSettings", "adopt", "confirm", "default_storage", "run",
-           "settings", "summary_path", "write_summary"]
+__all__ = [
+  "DEFAULT_TRIALS",
+  "TuneSettings",
+  "adopt",
+  "confirm",
+  "default_storage",
+  "run",
+  "settings",
+  "summary_path",
+  "write_summary",
+]

@@ -47,8 +47,10 @@ _PRUNER_STARTUP_TRIALS = 3  # Complete trials before the pruner may stop one.
 _PRUNER_WARMUP_EPOCHS = 3  # Epochs every trial runs before it may be pruned.
 _SEED_STRIDE = 100_000  # Trial n's sampler seed is seed * _SEED_STRIDE + n.
 _FINISHED = (optuna.trial.TrialState.COMPLETE, optuna.trial.TrialState.PRUNED)
-OBJECTIVE = ("best validation action MSE of the closed-loop inverse model (normalised units, "
-             "aux term left out) on the babbling dataset's validation split")
+OBJECTIVE = (
+  "best validation action MSE of the closed-loop inverse model (normalised units, "
+  "aux term left out) on the babbling dataset's validation split"
+)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -75,23 +77,35 @@ class TuneSettings:
   def description(self) -> dict:
     """What the study's trials depend on; a study resumed under another description is refused."""
     arm = robots.make(self.robot)
-    return {"agent": self.agent, "robot": self.robot,
-            "robot_xml_sha256": hashlib.sha256(arm.to_xml().encode()).hexdigest(),
-            "profile": self.profile.name, "samples": self.profile.samples,
-            "max_epochs": self.profile.max_epochs, "trial_epochs": self.epochs,
-            "patience": self.profile.patience,
-            "compile": self.profile.compile, "seed": self.seed,
-            "search_space": hyperparameters.describe_space(self.agent),
-            "training_version": learned.TRAINING_VERSION}
+    return {
+      "agent": self.agent,
+      "robot": self.robot,
+      "robot_xml_sha256": hashlib.sha256(arm.to_xml().encode()).hexdigest(),
+      "profile": self.profile.name,
+      "samples": self.profile.samples,
+      "max_epochs": self.profile.max_epochs,
+      "trial_epochs": self.epochs,
+      "patience": self.profile.patience,
+      "compile": self.profile.compile,
+      "seed": self.seed,
+      "search_space": hyperparameters.describe_space(self.agent),
+      "training_version": learned.TRAINING_VERSION,
+    }
 
 
 def default_storage() -> str:
   return f"sqlite:///{storage.softbench_home() / DATABASE}"
 
 
-def settings(agent: str, robot: str, trials: int = DEFAULT_TRIALS, storage_url: str | None = None,
-             profile: str = profiles.DEFAULT_PROFILE, study_name: str | None = None,
-             epochs: int | None = None) -> TuneSettings:
+def settings(
+  agent: str,
+  robot: str,
+  trials: int = DEFAULT_TRIALS,
+  storage_url: str | None = None,
+  profile: str = profiles.DEFAULT_PROFILE,
+  study_name: str | None = None,
+  epochs: int | None = None,
+) -> TuneSettings:
   """Checked study settings; the storage is opened once to check that it can be.
 
   Raises:
@@ -100,17 +114,24 @@ def settings(agent: str, robot: str, trials: int = DEFAULT_TRIALS, storage_url: 
       opened (one line).
   """
   if agents.learner(agent) is None:
-    raise ValueError(f"agent {agent!r} is not trained on babbling, so it has nothing to tune "
-                     f"here; choose one of {', '.join(agents.babbling_learners())}")
+    raise ValueError(
+      f"agent {agent!r} is not trained on babbling, so it has nothing to tune "
+      f"here; choose one of {', '.join(agents.babbling_learners())}"
+    )
   robots.make(robot)
   chosen_profile = profiles.get(profile)
   if isinstance(trials, bool) or not isinstance(trials, int) or trials < 1:
     raise ValueError(f"trials must be a whole number of at least 1, got {trials!r}")
   epochs = chosen_profile.max_epochs if epochs is None else epochs
-  if (isinstance(epochs, bool) or not isinstance(epochs, int)
-      or not 1 <= epochs <= chosen_profile.max_epochs):
-    raise ValueError(f"epochs must be a whole number from 1 to the {chosen_profile.name} "
-                     f"profile's {chosen_profile.max_epochs}, got {epochs!r}")
+  if (
+    isinstance(epochs, bool)
+    or not isinstance(epochs, int)
+    or not 1 <= epochs <= chosen_profile.max_epochs
+  ):
+    raise ValueError(
+      f"epochs must be a whole number from 1 to the {chosen_profile.name} "
+      f"profile's {chosen_profile.max_epochs}, got {epochs!r}"
+    )
   name = study_name if study_name is not None else f"{agent}-{robot}-{chosen_profile.name}"
   if not name.strip():
     raise ValueError("the study name must not be empty")
@@ -168,15 +189,20 @@ def confirm(settings: TuneSettings, study_summary: dict, show_progress: bool = T
   trained at the profile's full epoch budget (the trials' own values where that was theirs)."""
   previous, best = study_summary["previous_values"], study_summary["best"]
   if previous is None or best is None:
-    raise ValueError(f"study {settings.study_name!r} has no complete trial of the previous "
-                     f"and the best values to confirm")
+    raise ValueError(
+      f"study {settings.study_name!r} has no complete trial of the previous "
+      f"and the best values to confirm"
+    )
   if settings.epochs == settings.profile.max_epochs:
     losses = {"previous": previous["value"], "best": best["value"]}
   else:
     trainer = _Trainer(settings, show_progress)
     losses = {"previous": _finite(trainer.validation_loss(previous["params"], settings.profile))}
-    losses["best"] = (losses["previous"] if best["params"] == previous["params"] else
-                      _finite(trainer.validation_loss(best["params"], settings.profile)))
+    losses["best"] = (
+      losses["previous"]
+      if best["params"] == previous["params"]
+      else _finite(trainer.validation_loss(best["params"], settings.profile))
+    )
   return {**study_summary, "full_budget": {"epochs": settings.profile.max_epochs, **losses}}
 
 
@@ -190,53 +216,82 @@ class _Trainer:
     arm = robots.make(settings.robot)
     self.views = self.learner.views(arm)
     self.windows, self.forwards = learned.trained_forward_models(
-        arm, self.views, settings.seed, settings.profile, show_progress)
+      arm, self.views, settings.seed, settings.profile, show_progress
+    )
 
-  def validation_loss(self, params: dict, profile: profiles.Profile,
-                      on_epoch: learned.EpochCallback | None = None) -> float:
-    _, loss = learned.train_inverse(self.views, self.windows, self.forwards, self.settings.seed,
-                                    profile, self.learner.per_module, self.learner.make_model,
-                                    params, on_epoch=on_epoch, restart_diverged=False)
+  def validation_loss(
+    self, params: dict, profile: profiles.Profile, on_epoch: learned.EpochCallback | None = None
+  ) -> float:
+    _, loss = learned.train_inverse(
+      self.views,
+      self.windows,
+      self.forwards,
+      self.settings.seed,
+      profile,
+      self.learner.per_module,
+      self.learner.make_model,
+      params,
+      on_epoch=on_epoch,
+      restart_diverged=False,
+    )
     return loss  # A diverging trial scores its own learning rate, not half of it.
 
 
 def summary(study: optuna.Study, settings: TuneSettings) -> dict:
   """What the study found, without anything that depends on where it is stored."""
-  complete = [trial for trial in study.trials
-              if trial.state == optuna.trial.TrialState.COMPLETE]
+  complete = [trial for trial in study.trials if trial.state == optuna.trial.TrialState.COMPLETE]
   best = min(complete, key=lambda trial: trial.value) if complete else None
-  previous = next((trial for trial in study.trials if trial.user_attrs.get("previous_values")
-                   and trial.state == optuna.trial.TrialState.COMPLETE), None)
-  describe = lambda trial: (None if trial is None else
-                            {"trial": trial.number, "value": _finite(trial.value),
-                             "params": trial.params})
+  previous = next(
+    (
+      trial
+      for trial in study.trials
+      if trial.user_attrs.get("previous_values") and trial.state == optuna.trial.TrialState.COMPLETE
+    ),
+    None,
+  )
+  describe = lambda trial: (
+    None
+    if trial is None
+    else {"trial": trial.number, "value": _finite(trial.value), "params": trial.params}
+  )
   return {
-      "study": settings.study_name,
-      "agent": settings.agent,
-      "robot": settings.robot,
-      "profile": settings.profile.name,
-      "samples": settings.profile.samples,
-      "max_epochs": settings.profile.max_epochs,
-      "trial_epochs": settings.epochs,
-      "patience": settings.profile.patience,
-      "seed": settings.seed,
-      "objective": OBJECTIVE,
-      "search_space": hyperparameters.describe_space(settings.agent),
-      "sampler": f"TPE, seed {settings.seed}, {_TPE_STARTUP_TRIALS} startup trials",
-      "pruner": (f"median, after {_PRUNER_STARTUP_TRIALS} complete trials and "
-                 f"{_PRUNER_WARMUP_EPOCHS} warm-up epochs"),
-      "trials": {state: _count(study, (getattr(optuna.trial.TrialState, state.upper()),))
-                 for state in ("complete", "pruned", "fail")},
-      "best": describe(best),
-      "previous_values": describe(previous),
-      "trial_seconds": round(sum(_seconds(trial) for trial in study.trials), 1),
-      "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-      "optuna_version": optuna.__version__,
-      "softbench_version": softbench.__version__,
-      "trial_table": [{"number": trial.number, "state": trial.state.name.lower(),
-                       "value": _finite(trial.value), "epochs": trial.user_attrs.get("epochs"),
-                       "seconds": round(_seconds(trial), 1), "params": trial.params}
-                      for trial in study.trials],
+    "study": settings.study_name,
+    "agent": settings.agent,
+    "robot": settings.robot,
+    "profile": settings.profile.name,
+    "samples": settings.profile.samples,
+    "max_epochs": settings.profile.max_epochs,
+    "trial_epochs": settings.epochs,
+    "patience": settings.profile.patience,
+    "seed": settings.seed,
+    "objective": OBJECTIVE,
+    "search_space": hyperparameters.describe_space(settings.agent),
+    "sampler": f"TPE, seed {settings.seed}, {_TPE_STARTUP_TRIALS} startup trials",
+    "pruner": (
+      f"median, after {_PRUNER_STARTUP_TRIALS} complete trials and "
+      f"{_PRUNER_WARMUP_EPOCHS} warm-up epochs"
+    ),
+    "trials": {
+      state: _count(study, (getattr(optuna.trial.TrialState, state.upper()),))
+      for state in ("complete", "pruned", "fail")
+    },
+    "best": describe(best),
+    "previous_values": describe(previous),
+    "trial_seconds": round(sum(_seconds(trial) for trial in study.trials), 1),
+    "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+    "optuna_version": optuna.__version__,
+    "softbench_version": softbench.__version__,
+    "trial_table": [
+      {
+        "number": trial.number,
+        "state": trial.state.name.lower(),
+        "value": _finite(trial.value),
+        "epochs": trial.user_attrs.get("epochs"),
+        "seconds": round(_seconds(trial), 1),
+        "params": trial.params,
+      }
+      for trial in study.trials
+    ],
   }
 
 
@@ -254,8 +309,9 @@ def adopt(study_summary: dict, path: pathlib.Path | None = None) -> None:
   if study_summary["best"] is None:
     raise ValueError(f"study {study_summary['study']!r} has no complete trial to adopt")
   compact = {key: value for key, value in study_summary.items() if key != "trial_table"}
-  hyperparameters.adopt(study_summary["agent"], study_summary["robot"],
-                        study_summary["best"]["params"], compact, path)
+  hyperparameters.adopt(
+    study_summary["agent"], study_summary["robot"], study_summary["best"]["params"], compact, path
+  )
 
 
 def _open_storage(url: str) -> optuna.storages.RDBStorage:
@@ -263,42 +319,52 @@ def _open_storage(url: str) -> optuna.storages.RDBStorage:
     return optuna.storages.RDBStorage(url)
   except Exception as error:  # SQLAlchemy's URL, driver and connection errors, all bad input.
     lines = str(error).strip().splitlines()
-    raise ValueError(f"cannot open the study storage {url!r}: "
-                     f"{lines[0] if lines else type(error).__name__}") from None
+    raise ValueError(
+      f"cannot open the study storage {url!r}: {lines[0] if lines else type(error).__name__}"
+    ) from None
 
 
 def _load_study(settings: TuneSettings) -> optuna.Study:
-  study = optuna.create_study(storage=_open_storage(settings.storage),
-                              study_name=settings.study_name, direction="minimize",
-                              pruner=optuna.pruners.MedianPruner(
-                                  n_startup_trials=_PRUNER_STARTUP_TRIALS,
-                                  n_warmup_steps=_PRUNER_WARMUP_EPOCHS),
-                              load_if_exists=True)
+  study = optuna.create_study(
+    storage=_open_storage(settings.storage),
+    study_name=settings.study_name,
+    direction="minimize",
+    pruner=optuna.pruners.MedianPruner(
+      n_startup_trials=_PRUNER_STARTUP_TRIALS, n_warmup_steps=_PRUNER_WARMUP_EPOCHS
+    ),
+    load_if_exists=True,
+  )
   description = settings.description
   stored = study.user_attrs.get("settings")
   if stored is None:
     study.set_user_attr("settings", description)
-    study.set_user_attr("previous_values",
-                        hyperparameters.values(settings.agent, settings.robot))
+    study.set_user_attr("previous_values", hyperparameters.values(settings.agent, settings.robot))
   elif stored != description:
-    differences = ", ".join(key for key in sorted(description | stored)
-                            if stored.get(key) != description.get(key))
-    raise ValueError(f"study {settings.study_name!r} was made with other settings "
-                     f"({differences}); choose another --study name")
+    differences = ", ".join(
+      key for key in sorted(description | stored) if stored.get(key) != description.get(key)
+    )
+    raise ValueError(
+      f"study {settings.study_name!r} was made with other settings "
+      f"({differences}); choose another --study name"
+    )
   return study
 
 
 def _enqueue_previous_values(study: optuna.Study) -> None:
   """Queues the values in use at the study's start, unless a trial has them or will."""
   waiting_or_done = (optuna.trial.TrialState.WAITING, *_FINISHED)
-  if not any(trial.user_attrs.get("previous_values") for trial in study.trials
-             if trial.state in waiting_or_done):
+  if not any(
+    trial.user_attrs.get("previous_values")
+    for trial in study.trials
+    if trial.state in waiting_or_done
+  ):
     study.enqueue_trial(study.user_attrs["previous_values"], user_attrs={"previous_values": True})
 
 
 def _sampler(seed: int, trial_number: int) -> optuna.samplers.TPESampler:
-  return optuna.samplers.TPESampler(seed=seed * _SEED_STRIDE + trial_number,
-                                    n_startup_trials=_TPE_STARTUP_TRIALS)
+  return optuna.samplers.TPESampler(
+    seed=seed * _SEED_STRIDE + trial_number, n_startup_trials=_TPE_STARTUP_TRIALS
+  )
 
 
 def _count(study: optuna.Study, states: tuple) -> int:
@@ -321,8 +387,9 @@ class _TrialProgress:
 
   def __init__(self, settings: TuneSettings, study: optuna.Study, show: bool) -> None:
     self._progress = progress_bars.counting(show, extra=(TextColumn("{task.fields[best]}"),))
-    self._task = self._progress.add_task(f"tune {settings.agent} {settings.robot}",
-                                         total=settings.trials, best="")
+    self._task = self._progress.add_task(
+      f"tune {settings.agent} {settings.robot}", total=settings.trials, best=""
+    )
     self.update(study)
 
   def __enter__(self) -> "_TrialProgress":
@@ -335,5 +402,8 @@ class _TrialProgress:
   def update(self, study: optuna.Study) -> None:
     complete = study.get_trials(deepcopy=False, states=(optuna.trial.TrialState.COMPLETE,))
     best = min((trial.value for trial in complete), default=None)
-    self._progress.update(self._task, completed=_count(study, _FINISHED),
-                          best="" if best is None else f"best {best:.3e}")
+    self._progress.update(
+      self._task,
+      completed=_count(study, _FINISHED),
+      best="" if best is None else f"best {best:.3e}",
+    )

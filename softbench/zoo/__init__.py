@@ -98,13 +98,15 @@ def read_manifest(zoo: pathlib.Path) -> dict[str, Entry]:
     content = json.loads(path.read_text())
     if content.get("format") != FORMAT or content.get("version") != VERSION:
       raise ValueError(f"not a {FORMAT} manifest of version {VERSION}")
-    entries = [Entry(**{**entry, "records": tuple(entry["records"])})
-               for entry in content["entries"]]
+    entries = [
+      Entry(**{**entry, "records": tuple(entry["records"])}) for entry in content["entries"]
+    ]
     if any(entry.kind not in KINDS or not _inside(entry.path) for entry in entries):
       raise ValueError("an entry of unknown kind or with a path outside the zoo")
   except Exception as error:  # Any damage (bad JSON, a missing or extra field, a wrong type).
-    raise ValueError(f"{path}: unreadable zoo manifest ({type(error).__name__}: "
-                     f"{first_line(error)})") from None
+    raise ValueError(
+      f"{path}: unreadable zoo manifest ({type(error).__name__}: {first_line(error)})"
+    ) from None
   return {entry.path: entry for entry in entries}
 
 
@@ -115,8 +117,11 @@ def _inside(relative: str) -> bool:
 
 
 def write_manifest(zoo: pathlib.Path, entries: dict[str, Entry]) -> None:
-  content = {"format": FORMAT, "version": VERSION,
-             "entries": [entries[path].to_json() for path in sorted(entries)]}
+  content = {
+    "format": FORMAT,
+    "version": VERSION,
+    "entries": [entries[path].to_json() for path in sorted(entries)],
+  }
   storage.write_atomically(zoo / MANIFEST, json.dumps(content, indent=1, sort_keys=True) + "\n")
 
 
@@ -153,8 +158,10 @@ def restore(cache_file: pathlib.Path) -> list[str]:
     return []
   taken = [entry.path for entry in state if _copy_checked(zoo, entry, home)]
   if taken:
-    _say(f"resuming the training of {pathlib.PurePosixPath(relative).stem} from its saved "
-         f"state ({len(taken)} of {len(state)} files)")
+    _say(
+      f"resuming the training of {pathlib.PurePosixPath(relative).stem} from its saved "
+      f"state ({len(taken)} of {len(state)} files)"
+    )
   return taken
 
 
@@ -176,12 +183,19 @@ def _copy_checked(zoo: pathlib.Path, entry: Entry, home: pathlib.Path) -> bool:
   try:
     content = source.read_bytes()
   except OSError as error:
-    warnings.warn(f"{source}: unreadable zoo file ({first_line(error)}); training "
-                  f"instead", ZooWarning, stacklevel=3)
+    warnings.warn(
+      f"{source}: unreadable zoo file ({first_line(error)}); training instead",
+      ZooWarning,
+      stacklevel=3,
+    )
     return False
   if hashlib.sha256(content).hexdigest() != entry.sha256:
-    warnings.warn(f"{source}: its sha256 differs from the zoo manifest's (damaged or tampered); "
-                  f"refused, training instead", ZooWarning, stacklevel=3)
+    warnings.warn(
+      f"{source}: its sha256 differs from the zoo manifest's (damaged or tampered); "
+      f"refused, training instead",
+      ZooWarning,
+      stacklevel=3,
+    )
     return False
   storage.write_atomically(home / entry.path, content)
   return True
@@ -196,9 +210,12 @@ def stored_config(path: pathlib.Path) -> dict:
     return {}
 
 
-def add(cache_files: list[tuple[pathlib.Path, str]], records_of: dict[pathlib.Path, list[str]],
-        zoo: pathlib.Path, budget_bytes: int | None = BUDGET_BYTES
-        ) -> tuple[list[Entry], list[pathlib.Path]]:
+def add(
+  cache_files: list[tuple[pathlib.Path, str]],
+  records_of: dict[pathlib.Path, list[str]],
+  zoo: pathlib.Path,
+  budget_bytes: int | None = BUDGET_BYTES,
+) -> tuple[list[Entry], list[pathlib.Path]]:
   """Copies each ``(cache file, kind)`` from the data home into ``zoo``, or, for one not yet
   written, the saved state of its unfinished training (``KEY.partial/``, which replaces the
   state the zoo held for it); a finished file replaces the training state the zoo held for it.
@@ -220,8 +237,9 @@ def add(cache_files: list[tuple[pathlib.Path, str]], records_of: dict[pathlib.Pa
     if cache_file.is_file():
       sources = [(cache_file, kind, stored_config(cache_file))]
     elif partial.is_dir() and any(partial.iterdir()):
-      sources = [(path, "training-state", {}) for path in sorted(partial.iterdir())
-                 if path.is_file()]
+      sources = [
+        (path, "training-state", {}) for path in sorted(partial.iterdir()) if path.is_file()
+      ]
     else:
       skipped.append(cache_file)
       continue
@@ -231,19 +249,37 @@ def add(cache_files: list[tuple[pathlib.Path, str]], records_of: dict[pathlib.Pa
     entries = {path: entry for path, entry in entries.items() if not path.startswith(prefix)}
     for source, source_kind, config in sources:
       path = source.relative_to(home).as_posix()
-      records = tuple(sorted(set(records_of.get(cache_file, ())) | set(
-          entries[path].records if path in entries else ())))
+      records = tuple(
+        sorted(
+          set(records_of.get(cache_file, ()))
+          | set(entries[path].records if path in entries else ())
+        )
+      )
       content = source.read_bytes()  # Read once: hashed now, written below.
-      planned[path] = (content, Entry(path, hashlib.sha256(content).hexdigest(), len(content),
-                                      source_kind, cache_file.stem, config, records))
+      planned[path] = (
+        content,
+        Entry(
+          path,
+          hashlib.sha256(content).hexdigest(),
+          len(content),
+          source_kind,
+          cache_file.stem,
+          config,
+          records,
+        ),
+      )
   if not planned:
-    raise ValueError(f"nothing of this setting is trained or being trained in the data home "
-                     f"{home}; run its training first")
+    raise ValueError(
+      f"nothing of this setting is trained or being trained in the data home "
+      f"{home}; run its training first"
+    )
   updated = {**entries, **{path: entry for path, (_, entry) in planned.items()}}
   total = size_bytes(updated)
   if budget_bytes is not None and total > budget_bytes:
-    raise ValueError(f"the zoo would hold {total / 2**20:.1f} MiB, over its budget of "
-                     f"{budget_bytes / 2**20:.0f} MiB; nothing was added")
+    raise ValueError(
+      f"the zoo would hold {total / 2**20:.1f} MiB, over its budget of "
+      f"{budget_bytes / 2**20:.0f} MiB; nothing was added"
+    )
   for path, (content, _) in planned.items():
     storage.write_atomically(zoo / path, content)
   for stale in set(before) - set(updated):

@@ -3,10 +3,13 @@
 import pytest
 import torch
 
-from smpl import files, snapshots, training
+from smpl import files
+from smpl import snapshots
+from smpl import training
 from smpl.baselines import VAELSTMInverse
 from smpl.forward_model import ForwardModel
-from smpl.windows import BabblingWindows, inverse_input_size
+from smpl.windows import BabblingWindows
+from smpl.windows import inverse_input_size
 
 CPU = torch.device("cpu")
 POSE, ACTION = 6, 2
@@ -20,9 +23,11 @@ class Interrupted(Exception):
 
 def windows(count, seed):
   generator = torch.Generator().manual_seed(seed)
-  return BabblingWindows(torch.rand(count, 17, POSE, generator=generator),
-                         torch.rand(count, 15, ACTION, generator=generator),
-                         torch.zeros(count, 15, 0))
+  return BabblingWindows(
+    torch.rand(count, 17, POSE, generator=generator),
+    torch.rand(count, 15, ACTION, generator=generator),
+    torch.zeros(count, 15, 0),
+  )
 
 
 TRAIN, VALIDATION = windows(64, 1), windows(16, 2)
@@ -45,8 +50,9 @@ def train_forward(model, on_epoch_end=None, config=FORWARD):
 
 def train_vae(model, on_epoch_end=None, config=INVERSE):
   # The VAE draws latent noise from torch's generator: resuming must restore it too.
-  return training.train_inverse_model(model, FROZEN_FORWARD, TRAIN, VALIDATION, config, CPU,
-                                      on_epoch_end)
+  return training.train_inverse_model(
+    model, FROZEN_FORWARD, TRAIN, VALIDATION, config, CPU, on_epoch_end
+  )
 
 
 def vae():
@@ -62,12 +68,14 @@ def stop_at(epoch):
   def on_epoch_end(report):
     if report.epoch == epoch:
       raise Interrupted
+
   return on_epoch_end
 
 
 def same_weights(first, second):
-  return all(torch.equal(a, b) for a, b in zip(first.state_dict().values(),
-                                               second.state_dict().values()))
+  return all(
+    torch.equal(a, b) for a, b in zip(first.state_dict().values(), second.state_dict().values())
+  )
 
 
 @pytest.fixture(autouse=True)
@@ -89,9 +97,12 @@ def test_stopped_fit_resumes_to_the_same_weights_and_history(kind, tmp_path):
   assert epochs == list(range(len(expected.history)))
   assert same_weights(uninterrupted, resumed)
   assert [r.validation_loss for r in result.history] == [
-      r.validation_loss for r in expected.history]
+    r.validation_loss for r in expected.history
+  ]
   assert (result.best_epoch, result.best_validation_loss) == (
-      expected.best_epoch, expected.best_validation_loss)
+    expected.best_epoch,
+    expected.best_validation_loss,
+  )
 
 
 def test_finished_fit_returns_its_result_without_training(tmp_path, monkeypatch):
@@ -137,8 +148,10 @@ def test_unusable_snapshot_is_ignored_with_a_warning(spoil, tmp_path):
   fresh = forward_model()
   expected = train_forward(fresh, config=config)
   resumed = forward_model()
-  with pytest.warns(files.CorruptFileWarning, match="training that model from the start"), \
-       snapshots.resumable(tmp_path):
+  with (
+    pytest.warns(files.CorruptFileWarning, match="training that model from the start"),
+    snapshots.resumable(tmp_path),
+  ):
     result = train_forward(resumed, config=config)
   assert same_weights(fresh, resumed)
   assert result.history[0].validation_loss == expected.history[0].validation_loss
