@@ -21,7 +21,9 @@ MAX_TRAIL_MARKERS = 400  # Per module.
 MAX_PATH_SEGMENTS = 400  # Per module.
 TRAIL_RADIUS = 0.006  # Trail marker radius, in arm lengths.
 TARGET_RADIUS = 0.022  # Current-target marker radius, in arm lengths, or
-TARGET_ARM_SHARE = 0.5  # this share of the arm's drawn radius if larger (thick bellows arms).
+TARGET_ARM_SHARE = 1.3  # this share of the arm's drawn radius if larger: a target on the tip
+# shows as a translucent halo around it rather than hiding inside the arm.
+TARGET_ALPHA = 0.45
 PATH_RADIUS = 0.005  # Achieved-path capsule radius, in arm lengths.
 TRAIL_ALPHA = 0.55
 MIN_CAPTION_HEIGHT = 240  # (pixels) Smaller frames get no caption, which would cover them.
@@ -71,7 +73,7 @@ def _subsample(count: int, limit: int) -> np.ndarray:
 
 def target_rgba(colour: np.ndarray) -> np.ndarray:
   """The colour of a module's current-target marker, from the module's ``colour``."""
-  return _tint(colour, _WHITE, 0.25, 0.85)
+  return _tint(colour, _WHITE, 0.25, TARGET_ALPHA)
 
 
 def target_radius(robot_length: float, arm_radius: float) -> float:

@@ -97,6 +97,7 @@ def scene_model(robot: base.SoftArm, points: np.ndarray, width: int, height: int
   points = np.concatenate([points, base_plate_points(robot_model)])
   spec = mujoco.MjSpec.from_string(xml)
   spec.modelname = f"{robot.name} video scene"
+  round_segment_ends(spec)
   length = robot.length
   spec.visual.global_.offwidth = max(width, spec.visual.global_.offwidth)
   spec.visual.global_.offheight = max(height, spec.visual.global_.offheight)
@@ -154,6 +155,16 @@ def scene_model(robot: base.SoftArm, points: np.ndarray, width: int, height: int
     position, quaternion = camera_pose(camera, points, padding, width / height)
     spec.worldbody.add_camera(name=camera, pos=position, quat=quaternion, fovy=FOVY_DEG)
   return spec.compile()
+
+
+def round_segment_ends(spec: mujoco.MjSpec) -> None:
+  """Draws the rod's cylinder segments as capsules of the same radius and axis: where the rod
+  bends, cylinders leave wedge-shaped gaps that show their flat ends, so that from above the rod
+  looked like an open half-pipe; a capsule's round ends close them. Only the picture changes:
+  the scene takes its state from the simulation (``show_state``) and is never stepped."""
+  for geom in spec.geoms:
+    if geom.type == mujoco.mjtGeom.mjGEOM_CYLINDER and geom.name.startswith("module"):
+      geom.type = mujoco.mjtGeom.mjGEOM_CAPSULE
 
 
 def robot_geom_budget(model: mujoco.MjModel) -> int:
