@@ -14,10 +14,8 @@ from softbench import adaptive
 from softbench import agents
 from softbench import continual
 from softbench import data
-from softbench import episode_snapshots
 from softbench import leaderboard
 from softbench import parallel_seeds
-from softbench import plots
 from softbench import profiles
 from softbench import retrain as retrain_module
 from softbench import robots
@@ -27,7 +25,6 @@ from softbench import storage
 from softbench import suite
 from softbench import tuning
 from softbench import zoo
-from softbench.adaptive import plot as adaptive_plot
 from softbench.agents import hyperparameters
 from softbench.data import dataset
 from softbench.data import seeding
@@ -263,15 +260,8 @@ def _run_protocol(args: argparse.Namespace) -> None:
   record = continual.execute(
     profile, args.seeds, workers=args.workers, keep_seeds=True, family=family
   )
-  path, *_ = saving.save(continual, record, pathlib.Path(args.results), _json_copy(args))
-  # Only now: a failed write leaves a run that resumes.
-  episode_snapshots.discard_folder(continual.finished_seeds_folder(profile, family))
-  heat_map = plots.forgetting_matrix(
-    continual.mean_forgetting(record),
-    record["robots"],
-    path.with_name(f"{path.stem}-forgetting.png"),
-  )
-  print(f"plot: {heat_map}")
+  files = saving.save(continual, record, pathlib.Path(args.results), _json_copy(args))
+  continual.finish(record, files)
 
 
 def _number(name: str, text: str, kind: type) -> int | float:
@@ -309,24 +299,6 @@ def _video_flags_given(args: argparse.Namespace) -> list[str]:
   return [flag for flag, name, _ in _VIDEO_FLAGS if getattr(args, name) is not None]
 
 
-def _write_video(
-  settings: run_module.RunSettings,
-  seed: int,
-  episode,
-  path: pathlib.Path,
-  options: video_options.VideoOptions,
-) -> None:
-  stats = video.render(
-    run_module.replay_of(settings, seed, episode), path, options, show_progress=True
-  )
-  print(
-    f"video: {stats.path} ({stats.frames} frames, {options.width}x{options.height} at "
-    f"{options.fps:g} fps, {stats.frames / options.fps:.1f} s, "
-    f"{stats.size_bytes / 1024:.0f} KiB); rendered with {stats.backend} in "
-    f"{stats.render_seconds:.1f} s ({stats.frames_per_second:.1f} frames/s)"
-  )
-
-
 def _run(args: argparse.Namespace) -> None:
   if args.video is None and _video_flags_given(args):
     given = _video_flags_given(args)
@@ -358,20 +330,14 @@ def _run(args: argparse.Namespace) -> None:
   )
   if args.video and settings.adaptive:
     raise ValueError("--video renders one seed's episode; --adaptive draws its own figure")
+  video_request = None
   if args.video:
-    options = _video_options(args)
-    video_path = video_options.check_video_path(args.video)
+    video_request = run_module.VideoRequest(
+      video_options.check_video_path(args.video), _video_options(args)
+    )
   record, episodes = run_module.execute_episodes(settings, keep_seeds=True, workers=args.workers)
   files = saving.save(run_module, record, pathlib.Path(args.results), _json_copy(args))
-  path = files[0]
-  episode_snapshots.discard(settings)  # Only now: a failed write leaves a run that resumes.
-  if settings.adaptive:
-    print(f"plot: {adaptive_plot.write(record, path.with_suffix('.png'))}")
-  for plot in plots.save_run_plots(path, record, episodes) if episodes else ():
-    print(f"plot: {plot}")
-  if args.video:  # Once the record is safe; then the record links the video.
-    _write_video(settings, 0, episodes[0], video_path, options)
-    saving.link_video(record, files, video_path)
+  run_module.finish(settings, record, files, episodes, video_request)
 
 
 def _render(args: argparse.Namespace) -> None:
@@ -383,7 +349,7 @@ def _render(args: argparse.Namespace) -> None:
     args.task, args.agent, args.robot, 1, args.profile, args.eval, args.trajectory
   )
   episode = run_module.seed_episode(settings, seed, show_progress=True)
-  _write_video(settings, seed, episode, path, options)
+  run_module.write_video(settings, seed, episode, run_module.VideoRequest(path, options))
 
 
 def _add_video_arguments(parser: argparse.ArgumentParser) -> None:

@@ -34,6 +34,7 @@ from softbench import episodes
 from softbench import evaluation
 from softbench import metrics
 from softbench import parallel_seeds
+from softbench import plots
 from softbench import profiles
 from softbench import protocols
 from softbench import robots
@@ -421,6 +422,19 @@ def table(record: dict) -> str:
 def family_of(record: dict) -> str:
   """The tendon family of an Exp1S record's configurations."""
   return robots.tendon_family(record["robots"][0]).FAMILY
+
+
+def finish(record: dict, files: list[pathlib.Path]) -> None:
+  """What follows a saved record (``files``, the results folder's first): the finished seeds
+  kept for resuming go (only now: a failed write leaves a run that resumes), then the heat map
+  of forgetting beside the record."""
+  profile, family = profiles.get(record["profile"]), family_of(record)
+  episode_snapshots.discard_folder(finished_seeds_folder(profile, family))
+  path = files[0]
+  heat_map = plots.forgetting_matrix(
+    mean_forgetting(record), record["robots"], path.with_name(f"{path.stem}-forgetting.png")
+  )
+  print(f"plot: {heat_map}")
 
 
 def record_path(record: dict, results: pathlib.Path) -> pathlib.Path:

@@ -25,15 +25,20 @@ from softbench import episodes
 from softbench import evaluation
 from softbench import metrics
 from softbench import parallel_seeds
+from softbench import plots
 from softbench import profiles
 from softbench import records
 from softbench import robots
+from softbench import saving
 from softbench import suite
 from softbench import zoo
+from softbench.adaptive import plot as adaptive_plot
 from softbench.agents import learned
 from softbench.data import dataset
 from softbench.records import provenance
+from softbench.rendering import options as video_options
 from softbench.rendering import replay
+from softbench.rendering import video
 from softbench.robots import faults as fault_model
 from softbench.suite import reach
 from softbench.suite import trajectories
@@ -163,6 +168,42 @@ def task_options(run: RunSettings) -> dict:
     return {"trajectory": run.trajectory}
   options = {} if run.module is None else {"module": run.module}
   return {**options, **suite.length_options(run.task, run.profile.episode_length)}
+
+
+@dataclasses.dataclass(frozen=True)
+class VideoRequest:
+  """An MP4 of seed 0's episode to render once the record is safe (``--video``)."""
+
+  path: pathlib.Path
+  options: video_options.VideoOptions
+
+
+def write_video(
+  run: RunSettings, seed: int, episode: episodes.Episode, request: VideoRequest
+) -> None:
+  """Renders ``episode`` (seed ``seed`` of ``run``) as ``request`` asks; prints what it wrote."""
+  stats = video.render(replay_of(run, seed, episode), request.path, request.options, True)
+  print(stats.describe(request.options))
+
+
+def finish(
+  run: RunSettings,
+  record: dict,
+  files: list[pathlib.Path],
+  episodes_run: list[episodes.Episode],
+  video_request: VideoRequest | None = None,
+) -> None:
+  """What follows a saved record (``files``, the results folder's first): the finished seeds
+  kept for resuming go (only now: a failed write leaves a run that resumes), then the plots,
+  then the video, which the record files then link."""
+  episode_snapshots.discard(run)
+  if run.adaptive:
+    print(f"plot: {adaptive_plot.write(record, files[0].with_suffix('.png'))}")
+  for plot in plots.save_run_plots(files[0], record, episodes_run) if episodes_run else ():
+    print(f"plot: {plot}")
+  if video_request is not None:
+    write_video(run, 0, episodes_run[0], video_request)
+    saving.link_video(record, files, video_request.path)
 
 
 def replay_of(run: RunSettings, seed: int, episode: episodes.Episode) -> replay.Replay:

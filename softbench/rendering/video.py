@@ -63,6 +63,15 @@ class VideoStats:
   def frames_per_second(self) -> float:
     return self.frames / self.render_seconds if self.render_seconds > 0 else float("inf")
 
+  def describe(self, options: video_options.VideoOptions) -> str:
+    """One line: the file, its frames, size and how fast it was rendered with ``options``."""
+    return (
+      f"video: {self.path} ({self.frames} frames, {options.width}x{options.height} at "
+      f"{options.fps:g} fps, {self.frames / options.fps:.1f} s, "
+      f"{self.size_bytes / 1024:.0f} KiB); rendered with {self.backend} in "
+      f"{self.render_seconds:.1f} s ({self.frames_per_second:.1f} frames/s)"
+    )
+
 
 def backend_candidates() -> tuple[str, ...]:
   """Backends to try, in order: ``MUJOCO_GL`` if set, then ``OFFSCREEN_BACKENDS``."""
