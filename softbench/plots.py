@@ -240,3 +240,24 @@ def save_run_plots(
   tracking_paths(episodes[0], paths_png, f"{title}, seed 0", robot)
   tracking_errors(episodes, error_png, title, robot)
   return paths_png, error_png
+
+
+def performance_profiles(
+  curves: dict[str, np.ndarray], thresholds: np.ndarray, title: str, path: str | pathlib.Path
+) -> pathlib.Path:
+  """Saves performance profiles (rliable's): for each agent (``curves``' keys, in order) the share
+  of runs whose normalised tip error is at most each of ``thresholds`` (% of the arm's length,
+  drawn on a log axis)."""
+  figure = Figure(figsize=(6.4, 4.0))
+  axes = figure.add_subplot()
+  for index, (agent, shares) in enumerate(curves.items()):
+    axes.step(thresholds, shares, where="post", label=agent, color=f"C{index % 10}")
+  axes.set_xscale("log")
+  axes.set_ylim(-0.02, 1.02)
+  axes.set_xlabel("normalised tip error threshold τ (% of the arm's length)")
+  axes.set_ylabel("share of runs with error ≤ τ")
+  axes.set_title(title, fontsize="medium")
+  axes.grid(True, which="major", alpha=0.3)
+  axes.legend(fontsize="small", loc="upper left")
+  figure.tight_layout()
+  return _save(figure, path)

@@ -14,6 +14,7 @@ import pathlib
 
 from softbench import records
 from softbench import storage
+from softbench.leaderboard import aggregate
 from softbench.leaderboard import html_page
 from softbench.leaderboard import markdown_page
 from softbench.leaderboard import ranking
@@ -48,7 +49,11 @@ def write(
   }
   for name, content in pages.items():
     storage.write_atomically(out / name, content)
-  return [out / name for name in pages]
+  plots_written = []
+  for view in aggregate.views(board):
+    view.write_profiles(out)
+    plots_written.append(out / view.image)
+  return [out / name for name in pages] + plots_written
 
 
 __all__ = ["DEFAULT_OUT", "DEFAULT_RESULTS", "build", "ranking", "records", "text", "write"]

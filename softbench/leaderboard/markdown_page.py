@@ -3,6 +3,7 @@ table per robot and task, then the Exp1S records in the paper's layout."""
 
 import pathlib
 
+from softbench.leaderboard import aggregate
 from softbench.leaderboard import exp1s_board
 from softbench.leaderboard import figure_table
 from softbench.leaderboard import links
@@ -20,9 +21,7 @@ def _link(text: str, target: str) -> str:
   return f"[{_escaped(text)}](<{target}>)"
 
 
-def _intro(
-  board: ranking.Leaderboard, views: tuple[overview.Overview, ...], results_link: str
-) -> list[str]:
+def _intro(board: ranking.Leaderboard, views: tuple, results_link: str) -> list[str]:
   lines = [
     f"# {TITLE}",
     "",
@@ -60,6 +59,14 @@ def _overviews(views: tuple[overview.Overview, ...]) -> list[str]:
   for view in views:
     lines += [f'<a id="{view.anchor}"></a>', "", f"## {view.title}", "", *table_lines(view.table)]
   return lines + ([_escaped(overview.about_paper()), ""] if views else [])
+
+
+def _across(views: tuple[aggregate.View, ...]) -> list[str]:
+  lines = []
+  for view in views:
+    lines += [f'<a id="{view.anchor}"></a>', "", f"## {view.title}", "", *table_lines(view.table)]
+    lines += [f"![{view.title}: performance profiles]({view.image})", ""]
+  return lines
 
 
 def _table(group: ranking.Group, out: pathlib.Path) -> list[str]:
@@ -143,7 +150,8 @@ def render(board: ranking.Leaderboard, results: pathlib.Path, out: pathlib.Path)
   """The markdown page, with links relative to the folder ``out`` it is written to."""
   results_link = links.relative(pathlib.Path(results), out)
   views = overview.overviews(board)
-  lines = _intro(board, views, results_link) + _overviews(views)
+  across = aggregate.views(board)
+  lines = _intro(board, (*views, *across), results_link) + _overviews(views) + _across(across)
   for group in board.groups:
     lines += _table(group, out)
   for group in board.exp1s:

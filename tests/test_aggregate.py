@@ -1,0 +1,95 @@
+"""The leaderboard's aggregate across tasks (rliable's way): the IQM of every agent's runs, its
+stratified bootstrap interval and performance profiles, checked against the committed records
+and against direct computations."""
+
+import pathlib
+
+import numpy as np
+import pytest
+
+from softbench import leaderboard
+from softbench.leaderboard import aggregate
+
+RESULTS = pathlib.Path(__file__).resolve().parents[1] / "leaderboard" / "results"
+
+
+@pytest.fixture(scope="module")
+def views():
+  return aggregate.views(leaderboard.build(RESULTS))
+
+
+def test_the_iqm_is_the_mean_of_the_middle_half_of_the_runs():
+  runs = [np.array([1.0, 2.0, 3.0, 4.0]), np.array([10.0, 20.0, 30.0, 40.0])]
+  # Sorted: 1 2 3 4 10 20 30 40; the middle half is 3 4 10 20.
+  assert aggregate.iqm(runs) == pytest.approx(np.mean([3.0, 4.0, 10.0, 20.0]))
+
+
+def test_the_stratified_interval_keeps_each_task_s_share_of_runs():
+  # One task's runs all 0, the other's all 1: every stratified resample holds half of each, so
+  # its IQM is always 0.5 (an unstratified resample could draw all zeros).
+  runs = [np.zeros(5), np.ones(5)]
+  assert aggregate.stratified_interval(runs) == (0.5, 0.5)
+  spread = [np.array([0.1, 0.2, 0.4, 0.8, 1.6]), np.array([2.0, 2.5, 3.0, 3.5, 4.0])]
+  low, high = aggregate.stratified_interval(spread)
+  assert low < aggregate.iqm(spread) < high
+  assert aggregate.stratified_interval(spread) == (low, high)  # Seeded.
+
+
+def test_a_performance_profile_rises_from_none_to_every_run():
+  runs = [np.array([0.5, 1.0]), np.array([3.0, 30.0])]
+  thresholds = np.array([0.1, 0.5, 2.0, 10.0, 50.0])
+  np.testing.assert_allclose(
+    aggregate.performance_profile(runs, thresholds), [0.0, 0.25, 0.5, 0.75, 1.0]
+  )
+
+
+def test_every_aggregate_is_the_iqm_of_its_records_per_seed_errors(views):
+  assert views, "the committed records make no aggregate"
+  board = leaderboard.build(RESULTS)
+  shown = {
+    (group.robot, group.task, entry.setting): entry
+    for group in board.groups
+    if not group.variant
+    for entry in group.entries
+  }
+  for view in views:
+    iqms = [found.iqm for found in view.aggregates]
+    assert iqms == sorted(iqms)
+    for found in view.aggregates:
+      per_task = [
+        [
+          seed[aggregate.METRIC]["mean"]
+          for seed in shown[(view.robot, task, (found.agent, view.profile, view.eval_mode))].record[
+            "per_seed"
+          ]
+        ]
+        for task in aggregate.TASKS
+      ]
+      ordered = np.sort(np.concatenate(per_task))
+      cut = int(aggregate.TRIMMED * len(ordered))  # Whole runs cut from each end.
+      assert found.iqm == pytest.approx(np.mean(ordered[cut : len(ordered) - cut]))
+
+
+def test_an_agent_without_every_task_is_left_out(views):
+  board = leaderboard.build(RESULTS)
+  for view in views:
+    for found in view.aggregates:
+      tasks = {
+        group.task
+        for group in board.groups
+        if group.robot == view.robot and not group.variant
+        for entry in group.entries
+        if entry.setting == (found.agent, view.profile, view.eval_mode)
+      }
+      assert set(aggregate.TASKS) <= tasks
+
+
+def test_the_pages_show_every_aggregate_and_its_profile_plot(views, tmp_path):
+  board = leaderboard.build(RESULTS)
+  written = leaderboard.write(board, RESULTS, tmp_path)
+  page = (tmp_path / "README.md").read_text()
+  html = (tmp_path / "index.html").read_text()
+  for view in views:
+    assert f"## {view.title}" in page and view.image in page and view.anchor in html
+    assert (tmp_path / view.image).read_bytes()[:4] == b"\x89PNG"
+    assert tmp_path / view.image in written
