@@ -38,6 +38,7 @@ from softbench import plots
 from softbench import profiles
 from softbench import protocols
 from softbench import robots
+from softbench import storage
 from softbench import suite
 from softbench import zoo
 from softbench.agents import hyperparameters
@@ -82,8 +83,7 @@ class Exp1sConfig:
 
   @property
   def key(self) -> str:
-    text = repr(dataclasses.astuple(self)).encode()
-    return f"{PROTOCOL}-seed{self.seed}-{hashlib.sha256(text).hexdigest()[:12]}"
+    return storage.config_key(self, f"{PROTOCOL}-seed{self.seed}")
 
 
 @dataclasses.dataclass(frozen=True, eq=False)

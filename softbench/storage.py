@@ -5,6 +5,7 @@ The data home is ``$SOFTBENCH_HOME`` if set, else ``$XDG_CACHE_HOME/softbench`` 
 ``os.replace``, so a reader sees the old file or the new one, never half of one.
 """
 
+import dataclasses
 import hashlib
 import io
 import os
@@ -81,6 +82,13 @@ def check_home() -> pathlib.Path:
     ValueError: the data home is a file, lies under one, or cannot be written (one line).
   """
   return check_writable(softbench_home(), f"the data home (${HOME_VARIABLE})", folder=True)
+
+
+def config_key(config, name: str) -> str:
+  """A cache file's name for the frozen dataclass ``config`` (everything the cached thing depends
+  on): ``name``, a dash and the first 12 hex digits of the sha256 of its fields' ``repr``."""
+  text = repr(dataclasses.astuple(config)).encode()
+  return f"{name}-{hashlib.sha256(text).hexdigest()[:12]}"
 
 
 def arrays_sha256(arrays: dict[str, np.ndarray]) -> str:

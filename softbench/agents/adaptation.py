@@ -66,11 +66,11 @@ class RetrainedConfig:
 
   @property
   def key(self) -> str:
-    text = repr(dataclasses.astuple(self)).encode()
     faults = "-".join(f"{module}.{actuator}.{gain:g}" for module, actuator, gain in self.faults)
-    return (
+    return storage.config_key(
+      self,
       f"{self.healthy_checkpoint.split('-seed')[0]}-fault{faults}-column{self.column}-"
-      f"seed{self.seed}-{hashlib.sha256(text).hexdigest()[:12]}"
+      f"seed{self.seed}",
     )
 
 

@@ -48,8 +48,7 @@ class ForwardModelConfig:
 
   @property
   def key(self) -> str:
-    text = repr(dataclasses.astuple(self)).encode()
-    return f"{self.robot}-{self.view}-seed{self.seed}-{hashlib.sha256(text).hexdigest()[:12]}"
+    return storage.config_key(self, f"{self.robot}-{self.view}-seed{self.seed}")
 
 
 def cache_file(config: ForwardModelConfig) -> pathlib.Path:

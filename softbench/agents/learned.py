@@ -89,8 +89,7 @@ class TrainedConfig:
 
   @property
   def key(self) -> str:
-    text = repr(dataclasses.astuple(self)).encode()
-    return f"{self.agent}-{self.robot}-seed{self.seed}-{hashlib.sha256(text).hexdigest()[:12]}"
+    return storage.config_key(self, f"{self.agent}-{self.robot}-seed{self.seed}")
 
 
 @dataclasses.dataclass

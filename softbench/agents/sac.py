@@ -92,8 +92,7 @@ class TrainingConfig:
 
   @property
   def key(self) -> str:
-    text = repr(dataclasses.astuple(self)).encode()
-    return f"sac-{self.robot}-seed{self.seed}-{hashlib.sha256(text).hexdigest()[:12]}"
+    return storage.config_key(self, f"sac-{self.robot}-seed{self.seed}")
 
 
 def training_config(
