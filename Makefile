@@ -33,10 +33,11 @@ models: $(STAMP)
 PROFILE ?= paper
 WORKERS ?=# Processes per run (softbench run --workers); empty: one per core.
 RESULTS := leaderboard/results
-LEADERBOARD_ROBOTS := tendon-3 tendon-local-3 pneumatic-433
-LEADERBOARD_TASKS := babbling circle rectangle spiral reach
-LEADERBOARD_AGENTS := smpl mlp lstm vae-lstm bilstm sac reference zero random
-EXP1S_FAMILIES := tendon tendon-local
+# The grid comes from the library (softbench.leaderboard.grid), once softbench is installed.
+LEADERBOARD_ROBOTS = $(shell $(VENV)/bin/softbench leaderboard --grid robots)
+LEADERBOARD_TASKS = $(shell $(VENV)/bin/softbench leaderboard --grid tasks)
+LEADERBOARD_AGENTS = $(shell $(VENV)/bin/softbench leaderboard --grid agents)
+EXP1S_FAMILIES = $(shell $(VENV)/bin/softbench leaderboard --grid families)
 leaderboard: $(STAMP)
 	set -e; for robot in $(LEADERBOARD_ROBOTS); do for task in $(LEADERBOARD_TASKS); do \
 	  for agent in $(LEADERBOARD_AGENTS); do \

@@ -29,6 +29,7 @@ from softbench.agents import hyperparameters
 from softbench.data import dataset
 from softbench.data import seeding
 from softbench.leaderboard import doc_tables
+from softbench.leaderboard import grid
 from softbench.leaderboard import zoo_catalogue
 from softbench.leaderboard import zoo_verification
 from softbench.rendering import options as video_options
@@ -408,6 +409,9 @@ def _check_record_arguments(args: argparse.Namespace) -> None:
 
 
 def _leaderboard(args: argparse.Namespace) -> None:
+  if args.grid is not None:
+    print(" ".join(grid.lists()[args.grid]))
+    return
   results = pathlib.Path(args.results)
   board = leaderboard.build(results)
   print(leaderboard.text.report(board, results))
@@ -709,6 +713,11 @@ def build_parser() -> argparse.ArgumentParser:
     "--out",
     default=str(leaderboard.DEFAULT_OUT),
     help=f"folder of the pages (default {leaderboard.DEFAULT_OUT})",
+  )
+  board_parser.add_argument(
+    "--grid",
+    choices=tuple(grid.lists()),
+    help="print the names on one axis of the grid make leaderboard fills, and nothing else",
   )
   board_parser.set_defaults(run=_leaderboard)
   render_parser = commands.add_parser(

@@ -8,20 +8,22 @@ import subprocess
 import pytest
 
 from softbench import agents
+from softbench import cli
 from softbench import robots
+from softbench.leaderboard import grid
 
 MAKEFILE = pathlib.Path(__file__).parent.parent / "Makefile"
+# Answers the grid's questions as `softbench leaderboard --grid AXIS` does (checked below), and
+# records every other call.
 _RECORDING_SOFTBENCH = """#!/bin/sh
+if [ "$1 $2" = "leaderboard --grid" ]; then
+  case "$3" in
+{answers}
+  esac
+  exit 0
+fi
 echo "$@" >> "$(dirname "$0")/calls.txt"
 """
-
-
-def _variable(name: str) -> list[str]:
-  """A ``NAME := words`` variable of the Makefile, as its words."""
-  for line in MAKEFILE.read_text().splitlines():
-    if line.startswith(f"{name} :="):
-      return line.split(":=", 1)[1].split()
-  raise KeyError(name)
 
 
 @pytest.fixture
@@ -35,7 +37,10 @@ def checkout(tmp_path) -> pathlib.Path:
   venv_bin = tmp_path / ".venv" / "bin"
   venv_bin.mkdir(parents=True)
   softbench = venv_bin / "softbench"
-  softbench.write_text(_RECORDING_SOFTBENCH)
+  answers = "\n".join(
+    f"    {axis}) echo {' '.join(names)};;" for axis, names in grid.lists().items()
+  )
+  softbench.write_text(_RECORDING_SOFTBENCH.format(answers=answers))
   softbench.chmod(0o755)
   stamp = tmp_path / ".venv" / ".installed"
   stamp.touch()
@@ -59,11 +64,11 @@ def _fill(checkout: pathlib.Path) -> list[str]:
 
 def test_the_fill_runs_every_agent_on_every_task_then_exp1s_then_the_pages(checkout):
   calls = _fill(checkout)
-  assert set(_variable("LEADERBOARD_AGENTS")) == set(agents.AGENTS)
+  axes = grid.lists()
+  assert set(axes["agents"]) == set(agents.AGENTS)
   runs = [call for call in calls if "--task" in call]
-  assert len(runs) == (
-    len(_variable("LEADERBOARD_ROBOTS")) * len(_variable("LEADERBOARD_TASKS")) * len(agents.AGENTS)
-  )
+  assert len(runs) == len(axes["robots"]) * len(axes["tasks"]) * len(agents.AGENTS)
+  assert {call.split("--robot ")[1].split()[0] for call in runs} == set(axes["robots"])
   assert all("--profile paper" in call for call in runs)
   exp1s = [call for call in calls if "--protocol exp1s" in call]
   assert exp1s == [
@@ -94,3 +99,9 @@ def test_an_interrupted_fill_skips_the_settings_that_have_records(checkout):
   (results / "smpl-exp1s-tendon-local-paper-2026-11-24T000000Z.json").touch()
   (checkout / ".venv" / "bin" / "calls.txt").unlink()
   assert not any("exp1s" in call for call in _fill(checkout))
+
+
+@pytest.mark.parametrize("axis", list(grid.lists()))
+def test_the_cli_prints_each_axis_of_the_grid(axis, capsys):
+  assert cli.main(["leaderboard", "--grid", axis]) == 0
+  assert capsys.readouterr().out.split() == list(grid.lists()[axis])

@@ -1,0 +1,20 @@
+"""The settings the leaderboard is filled with (``make leaderboard``): every registered agent on
+every benchmarking task of ``ROBOTS``, then Exp1S on every tendon family."""
+
+from softbench import agents
+from softbench import robots
+from softbench import suite
+
+ROBOTS = ("tendon-3", "tendon-local-3", "pneumatic-433")
+"""The paper's robots (Exp2S tracking on tendon-3, reaching on pneumatic-433) and tendon-3's
+module-local plant, the paper simulator's arm."""
+
+
+def lists() -> dict[str, tuple[str, ...]]:
+  """The grid's axes by name: robots, tasks, agents and Exp1S families."""
+  return {
+    "robots": ROBOTS,
+    "tasks": tuple(task for task in suite.TASKS if "benchmarking" in suite.describe(task).tags),
+    "agents": agents.AGENTS,
+    "families": tuple(robots.TENDON_FAMILIES),
+  }
