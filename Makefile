@@ -16,7 +16,7 @@ run: $(STAMP)
 	$(VENV)/bin/softbench run --task spiral --agent smpl
 
 test: $(STAMP)
-	$(VENV)/bin/python -m pytest -q -n auto tests
+	$(VENV)/bin/python -m pytest -q -n auto --dist worksteal tests
 
 bench: $(STAMP)
 	$(VENV)/bin/python -m pytest -q benchmarks --benchmark-only --benchmark-columns=mean,stddev,rounds
