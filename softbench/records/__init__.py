@@ -1,11 +1,15 @@
 """Result records: their JSON Schema, their integrity hash, and checked writing and reading.
 
+The package owns every record format and imports no torch: run records here, Exp1S records in
+``records.exp1s``, the fields both share in ``records.fields``, provenance in
+``records.provenance``. Runners write through ``write``; the leaderboard reads through ``read``.
+
 A record is one ``softbench run`` (format ``softbench-result``, version 2): provenance, settings
 and per-seed errors; or one ``softbench run --protocol exp1s`` (format
-``softbench-exp1s-result``, version 2, schema and checks in ``exp1s_records``). Reading and
+``softbench-exp1s-result``, version 2, schema and checks in ``records.exp1s``). Reading and
 writing dispatch on ``format``. ``write`` seals a record with ``sha256``, the hash of the
 canonical JSON of everything else in it, and ``read`` refuses a file that is not valid JSON, does
-not match its kind's schema (``schema()``, ``exp1s_records.schema()``, JSON Schema draft
+not match its kind's schema (``schema()``, ``records.exp1s.schema()``, JSON Schema draft
 2020-12), holds a non-finite number, no longer matches its hash (a hand-edited number), or
 contradicts itself (seed count, module counts, the mean over modules). Every refusal is one line
 that names the file.

@@ -1,7 +1,7 @@
 """What every kind of result record shares: the JSON Schema of its provenance, agent, profile,
 seed and integrity fields, and the checks of those fields that a schema cannot make.
 
-``records`` (``softbench run``'s records) and ``exp1s_records`` (``softbench run --protocol
+``records`` (``softbench run``'s records) and ``records.exp1s`` (``softbench run --protocol
 exp1s``'s) build their schemas from these parts, so that the two kinds cannot drift apart.
 """
 
