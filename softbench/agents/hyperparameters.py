@@ -33,12 +33,13 @@ TRAINING_PARAMETERS = ("learning_rate", "batch_size", "weight_decay")
 def search_space(agent: str) -> Mapping:
   """The tuned parameters of learned agent ``agent`` and their ranges (its registry entry's
   ``Learner.search_space``)."""
-  tuned = {name: agents.learner(name).search_space for name in agents.babbling_learners()}
-  if agent not in tuned:
+  learner = agents.learner(agent) if agent in agents.AGENTS else None
+  if learner is None:
     raise ValueError(
-      f"agent {agent!r} has no hyperparameters to tune; learned agents: {', '.join(tuned)}"
+      f"agent {agent!r} has no hyperparameters to tune; learned agents: "
+      f"{', '.join(agents.babbling_learners())}"
     )
-  return tuned[agent]
+  return learner.search_space
 
 
 def describe_space(agent: str) -> dict[str, str]:

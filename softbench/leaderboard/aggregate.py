@@ -16,10 +16,13 @@ from scipy import stats
 
 from softbench import agents
 from softbench import plots
+from softbench import suite
 from softbench.leaderboard import figure_table
 from softbench.leaderboard import ranking
 
-TASKS = ("babbling", "circle", "rectangle", "spiral")  # Tracking tasks (reach scores one module).
+TASKS = tuple(
+  task for task in suite.TASKS if {"benchmarking", "tracking"} <= set(suite.describe(task).tags)
+)  # The benchmark's tracking tasks (reach scores one module).
 METRIC = "normalised_tip_percent"
 TRIMMED = 0.25  # Share cut from each end: the interquartile mean.
 BOOTSTRAP_RESAMPLES = 2_000
@@ -52,18 +55,17 @@ def performance_profile(runs: list[np.ndarray], thresholds=PROFILE_THRESHOLDS) -
 
 @dataclasses.dataclass(frozen=True)
 class Aggregate:
-  """One agent's runs over ``TASKS`` on one robot, profile and eval mode."""
+  """One agent's runs over ``TASKS`` on one robot, profile and eval mode, with their IQM and its
+  interval (``of`` computes both once)."""
 
   agent: str
   runs: tuple[np.ndarray, ...]  # One array of per-seed errors per task, in ``TASKS`` order.
+  iqm: float
+  interval: tuple[float, float]
 
-  @property
-  def iqm(self) -> float:
-    return iqm(list(self.runs))
-
-  @property
-  def interval(self) -> tuple[float, float]:
-    return stratified_interval(list(self.runs))
+  @classmethod
+  def of(cls, agent: str, runs: tuple[np.ndarray, ...]) -> "Aggregate":
+    return cls(agent, runs, iqm(list(runs)), stratified_interval(list(runs)))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -122,13 +124,9 @@ class View:
 def views(board: ranking.Leaderboard) -> tuple[View, ...]:
   """Every robot, profile and eval mode where an agent has records of all of ``TASKS``."""
   runs: dict[tuple[str, str, str], dict[str, dict[str, np.ndarray]]] = {}
-  for group in board.groups:
-    if group.variant or group.task not in TASKS:
-      continue
-    for entry in group.entries:
-      agent, profile, eval_mode = entry.setting
-      if METRIC not in entry.estimates:
-        continue
+  for group, entry in ranking.plain_entries(board):
+    agent, profile, eval_mode = entry.setting
+    if group.task in TASKS and METRIC in entry.estimates:
       per_seed = np.array([seed[METRIC]["mean"] for seed in entry.record["per_seed"]])
       runs.setdefault((group.robot, profile, eval_mode), {}).setdefault(agent, {})[group.task] = (
         per_seed
@@ -136,24 +134,12 @@ def views(board: ranking.Leaderboard) -> tuple[View, ...]:
   found = []
   for (robot, profile, eval_mode), by_agent in runs.items():
     complete = [
-      Aggregate(agent, tuple(tasks[task] for task in TASKS))
+      Aggregate.of(agent, tuple(tasks[task] for task in TASKS))
       for agent, tasks in by_agent.items()
       if set(TASKS) <= set(tasks)
     ]
     if complete:
-      complete.sort(key=lambda item: (item.iqm, _registry_order(item.agent)))
+      complete.sort(key=lambda item: (item.iqm, ranking.known_first(item.agent, agents.AGENTS)))
       found.append(View(robot, profile, eval_mode, tuple(complete)))
-  found.sort(
-    key=lambda view: (
-      ranking.robot_order(view.robot),
-      view.profile != "paper",
-      view.profile,
-      view.eval_mode != "physics",
-      view.eval_mode,
-    )
-  )
+  found.sort(key=lambda view: ranking.setting_order(view.robot, view.profile, view.eval_mode))
   return tuple(found)
-
-
-def _registry_order(agent: str) -> tuple:
-  return (0, agents.AGENTS.index(agent), "") if agent in agents.AGENTS else (1, 0, agent)

@@ -55,22 +55,15 @@ class Setting:
 
 def _entries(board: ranking.Leaderboard) -> dict[tuple[Setting, str, str], ranking.Entry]:
   """The shown entry of each (setting, task, agent), plain tasks only."""
-  found = {}
-  for group in board.groups:
-    if group.variant:
-      continue
-    for entry in group.entries:
-      agent, profile, eval_mode = entry.setting
-      found[Setting(group.robot, profile, eval_mode), group.task, agent] = entry
-  return found
+  return {
+    (Setting(group.robot, *entry.setting[1:]), group.task, entry.setting[0]): entry
+    for group, entry in ranking.plain_entries(board)
+  }
 
 
 def _agents_in(names) -> list[str]:
   """``names`` in registry order, then any others by name."""
-  names = set(names)
-  return [agent for agent in agents.AGENTS if agent in names] + sorted(
-    names.difference(agents.AGENTS)
-  )
+  return sorted(set(names), key=lambda agent: ranking.known_first(agent, agents.AGENTS))
 
 
 def _with_paper(estimate, robot: str, task: str, agent: str) -> str:

@@ -13,12 +13,10 @@ trajectory, a fault or an extra section is a different experiment.
 import dataclasses
 
 from softbench import agents
-from softbench import profiles
 from softbench import suite
 from softbench.leaderboard import paper_tables
 from softbench.leaderboard import ranking
 from softbench.leaderboard.figure_table import Table
-from softbench.records import fields as record_fields
 
 PAPER_FILE = "paper_exp2.json"  # In this package; its "source" names the paper's tables.
 METRIC = "position_mm"
@@ -54,12 +52,6 @@ class Overview:
     return f"overview-{self.robot}-{self.profile}-{self.eval_mode}"
 
 
-def _known_first(name: str, known) -> tuple:
-  """Sort key: the ``known`` names in their order, then any others by name."""
-  known = list(known)
-  return (0, known.index(name), "") if name in known else (1, 0, name)
-
-
 def _cell(estimate: ranking.Estimate, reference: float | None) -> str:
   text = ranking.mean_and_std(estimate)
   return text if reference is None else f"{text} ({reference:.2f})"
@@ -68,19 +60,16 @@ def _cell(estimate: ranking.Estimate, reference: float | None) -> str:
 def overviews(board: ranking.Leaderboard) -> tuple[Overview, ...]:
   """The overview of every robot, profile and eval mode with a plain-task record on ``board``."""
   cells: dict[tuple[str, str, str], dict[tuple[str, str], ranking.Estimate]] = {}
-  for group in board.groups:
-    if group.variant:
-      continue
-    for entry in group.entries:
-      agent, profile, eval_mode = entry.setting
-      cells.setdefault((group.robot, profile, eval_mode), {})[agent, group.task] = entry.estimates[
-        METRIC
-      ]
+  for group, entry in ranking.plain_entries(board):
+    agent, profile, eval_mode = entry.setting
+    cells.setdefault((group.robot, profile, eval_mode), {})[agent, group.task] = entry.estimates[
+      METRIC
+    ]
   tables = []
   for (robot, profile, eval_mode), estimates in cells.items():  # Already in the groups' order.
     tasks = sorted({task for _, task in estimates}, key=suite.TASKS.index)
     names = sorted(
-      {agent for agent, _ in estimates}, key=lambda agent: _known_first(agent, agents.AGENTS)
+      {agent for agent, _ in estimates}, key=lambda agent: ranking.known_first(agent, agents.AGENTS)
     )
     experiment = paper()["experiments"].get(paper_tables.paper_robot(robot))
     caption = "position error (mm), mean ± std over seeds of the module-averaged error; " + (
@@ -109,11 +98,7 @@ def overviews(board: ranking.Leaderboard) -> tuple[Overview, ...]:
   return tuple(
     sorted(
       tables,
-      key=lambda view: (
-        ranking.robot_order(view.robot),
-        _known_first(view.profile, profiles.PROFILES),
-        _known_first(view.eval_mode, record_fields.ERROR_SOURCES),
-      ),
+      key=lambda view: ranking.setting_order(view.robot, view.profile, view.eval_mode),
     )
   )
 

@@ -11,6 +11,7 @@ numbers; with fewer than 2 seeds there is no interval. Exp1S records are grouped
 (``exp1s_board``), in the paper's layout rather than a ranking.
 """
 
+from collections.abc import Iterator
 import dataclasses
 import datetime
 import math
@@ -19,10 +20,12 @@ import re
 
 import numpy as np
 
+from softbench import profiles
 from softbench import records
 from softbench import suite
 from softbench.leaderboard import exp1s_board
 from softbench.leaderboard import selection
+from softbench.records import fields as record_fields
 
 CONFIDENCE = 0.95
 BOOTSTRAP_RESAMPLES = 10_000
@@ -163,6 +166,30 @@ def robot_order(robot: str) -> tuple:
   tendon-local-1)."""
   family, _, size = robot.rpartition("-")
   return family, int(size) if size.isdigit() else 0, robot
+
+
+def known_first(name: str, known) -> tuple:
+  """Sort key: the ``known`` names in their order, then any others by name."""
+  known = list(known)
+  return (0, known.index(name), "") if name in known else (1, 0, name)
+
+
+def setting_order(robot: str, profile: str, eval_mode: str) -> tuple:
+  """Sort key of a robot, profile and eval mode: robots by ``robot_order``, profiles in
+  ``profiles.PROFILES`` order (paper first), eval modes as ``ERROR_SOURCES`` lists them."""
+  return (
+    robot_order(robot),
+    known_first(profile, profiles.PROFILES),
+    known_first(eval_mode, record_fields.ERROR_SOURCES),
+  )
+
+
+def plain_entries(board: "Leaderboard") -> Iterator[tuple[Group, Entry]]:
+  """Every shown row of a plain task (no trajectory or extra section), with its group."""
+  for group in board.groups:
+    if not group.variant:
+      for entry in group.entries:
+        yield group, entry
 
 
 def _moment(record: dict) -> datetime.datetime:

@@ -36,12 +36,12 @@ from softbench import storage
 from softbench import suite
 from softbench.records import exp1s as exp1s_records
 from softbench.records import fields as record_fields
+from softbench.records.fields import METRICS
 
 DEFAULT_FOLDER = pathlib.Path("leaderboard/results")  # Where softbench run writes records.
 FORMAT = "softbench-result"
 VERSION = 2
 INTEGRITY_FIELD = record_fields.INTEGRITY_FIELD
-METRICS = ("position_mm", "orientation_deg", "normalised_tip_percent")
 """Errors a record may hold per seed; position and normalised tip error always, orientation
 except for position-only tasks (reach)."""
 _OPTIONAL_FIELDS = ("video", "faults", "zoo", "training")

@@ -14,6 +14,7 @@ import math
 from softbench import metrics
 from softbench import robots
 from softbench.records import fields as record_fields
+from softbench.records.fields import METRICS
 
 FORMAT = "softbench-exp1s-result"
 VERSION = 2  # 2: sealed with an integrity hash.
@@ -21,7 +22,6 @@ PROTOCOL = "exp1s"
 TASKS = ("babbling", "circle", "rectangle", "spiral")  # The paper's Exp1S table.
 LOOPS = {"closed": "physics", "open": "open-loop"}  # Table label -> the agent's error source.
 FORGETTING_TASK = "spiral"
-METRICS = ("position_mm", "orientation_deg", "normalised_tip_percent")
 MATRICES = ("forgetting_model_pose_mse", "forgetting_tip_percent")
 _TIP_TOLERANCE = 1e-9  # Relative: normalised tip error against position error / robot length.
 

@@ -13,6 +13,7 @@ from softbench import profiles
 from softbench import robots
 
 INTEGRITY_FIELD = "sha256"
+METRICS = ("position_mm", "orientation_deg", "normalised_tip_percent")  # Every record kind's.
 ERROR_SOURCES = ("physics", "model", "open-loop")
 """What a learned controller's error input is computed from (a record's ``eval_mode``): the
 measured pose, the learned forward model's prediction, or nothing (``softbench.agents.learned``)."""
