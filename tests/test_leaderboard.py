@@ -5,6 +5,7 @@ others are variants of it (another agent, date or scale of the errors), sealed a
 """
 
 import copy
+import csv
 import json
 import math
 import os
@@ -21,6 +22,9 @@ from softbench import cli
 from softbench import leaderboard
 from softbench import records
 from softbench import run
+from softbench.leaderboard import aggregate
+from softbench.leaderboard import csv_table
+from softbench.leaderboard import log_chart
 from softbench.leaderboard import overview
 from softbench.leaderboard import ranking
 
@@ -371,12 +375,74 @@ def test_pages_contain_every_record(results, tmp_path, capsys):
   assert "(<../results/videos/zero.mp4>)" in markdown
   assert 'href="../results/videos/zero.mp4"' in page
   assert 'href="https://example.org/good.mp4"' in page
-  assert page.count('<table class="sortable">') == 3 and page.count("<svg") == 3 + 3 + 2
+  board = leaderboard.build(results)
+  settings = [{entry.setting[1:] for entry in group.entries} for group in board.groups]
+  boards = sum(len(found) for found in settings) + len(overview.overviews(board))
+  assert page.count('<table class="sortable">') == boards  # Every task board and overview.
+  # A log-axis chart per metric of each task board (one profile and eval mode each).
+  assert page.count("<svg") == len(aggregate.views(board)) + sum(
+    len(found) * len(group.metrics) for found, group in zip(settings, board.groups)
+  )
+  for found in settings:
+    for profile, eval_mode in found:
+      assert f'data-profile="{profile}" data-eval="{eval_mode}"' in page
+      assert (
+        f'name="profile" value="{profile}"' in page and f'name="eval" value="{eval_mode}"' in page
+      )
   assert "<link" not in page and "src=" not in page  # Self-contained: nothing to fetch.
   good = ranking.Estimate.of(
     [seed["position_mm"]["mean"] for seed in records.read(results / "good.json")["per_seed"]]
   )
-  assert ranking.cell(good) in markdown and ranking.cell(good) in page
+  low, high = (ranking.number(bound, ranking.decimals_of(good.mean)) for bound in good.interval)
+  assert ranking.cell(good) in markdown
+  assert (
+    f'data-value="{good.mean!r}">{ranking.mean_and_std(good)} <span class="ci">[{low}, {high}]'
+    in page
+  )
+  assert 'href="leaderboard.csv"' in page
+
+
+def test_the_csv_holds_every_shown_row_in_full(results, tmp_path):
+  board = leaderboard.build(results)
+  leaderboard.write(board, results, tmp_path)
+  with open(tmp_path / csv_table.FILE_NAME, newline="") as file:
+    rows = list(csv.DictReader(file))
+  shown = [(group, entry) for group in board.groups for entry in group.entries]
+  assert len(rows) == len(shown) and tuple(rows[0]) == csv_table.HEADER
+  for row, (group, entry) in zip(rows, shown):
+    assert (row["robot"], row["task"], row["variant"]) == (group.robot, group.task, group.variant)
+    assert (row["agent"], row["profile"], row["eval_mode"]) == entry.setting
+    assert row["record"] == pathlib.Path(os.path.relpath(entry.path, tmp_path)).as_posix()
+    for metric in records.METRICS:
+      estimate = entry.estimates.get(metric)
+      if estimate is None:
+        assert row[f"{metric}_mean"] == ""
+        continue
+      assert float(row[f"{metric}_mean"]) == estimate.mean  # In full, not rounded.
+      assert float(row[f"{metric}_std"]) == estimate.std
+      if estimate.interval is not None:
+        low, high = estimate.interval
+        assert (float(row[f"{metric}_ci_low"]), float(row[f"{metric}_ci_high"])) == (low, high)
+
+
+@pytest.mark.parametrize("means", [(0.001, 0.5, 120.0), (0.0, 3.0, 3.0), (0.0, 0.0), (7.0,)])
+def test_log_chart_bars_grow_with_the_mean_on_decade_ticks(means):
+  estimates = [ranking.Estimate(mean, 0.0, (mean * 0.9, mean * 1.1)) for mean in means]
+  chart = log_chart.chart([(f"row {i}", f"row {i}", e) for i, e in enumerate(estimates)], "c")
+  widths = [bar.width for bar in chart.bars]
+  assert all(0 <= width <= chart.right - chart.left for width in widths)
+  for (mean_a, width_a), (mean_b, width_b) in zip(zip(means, widths), zip(means[1:], widths[1:])):
+    assert (width_a < width_b) == (mean_a < mean_b) or mean_b <= 0
+  assert [bar.width for bar, mean in zip(chart.bars, means) if mean <= 0] == [0.0] * means.count(0)
+  positions = [x for x, _ in chart.ticks]
+  assert positions == sorted(positions) and len(positions) >= 2
+  assert chart.left <= positions[0] and positions[-1] <= chart.right
+  for x, label in chart.ticks:  # A tick sits where its decade's value would end a bar.
+    assert math.log10(float(label)) == pytest.approx(round(math.log10(float(label))))
+  for bar, mean in zip(chart.bars, means):
+    if mean > 0:
+      low, high = bar.whisker
+      assert low <= chart.left + bar.width <= high
 
 
 def test_regenerating_is_deterministic(results, tmp_path, assert_regenerates_identically):

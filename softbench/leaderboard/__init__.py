@@ -1,13 +1,14 @@
 """The leaderboard: result records ranked per robot and task, printed and written as pages.
 
-``records`` (schema, integrity hash, checked reading and writing, for every kind of record),
-``record_fields`` (the fields every kind shares), ``exp1s_records`` (the Exp1S record's schema
-and checks), ``ranking`` (newest record per agent, profile and eval mode; mean, std and
-bootstrap interval over seeds), ``overview`` (every agent on every task of a robot, beside the
-paper's Exp2S/Exp2R values), ``exp1s_board`` (Exp1S records in the paper's layout, beside the
-paper's values), ``figure_table`` (the tables every page renders alike), ``text`` (the printout),
-``markdown_page`` and ``html_page`` (``README.md`` and ``index.html``), ``doc_tables`` (the
-results tables of the repository's ``README.md`` and ``docs/*.md``).
+``ranking`` (newest record per agent, profile and eval mode; mean, std and bootstrap interval
+over seeds), ``overview`` (every agent on every task of a robot, beside the paper's Exp2S/Exp2R
+values), ``aggregate`` (each agent across tasks: IQM, stratified bootstrap interval, performance
+profiles), ``exp1s_board`` (Exp1S records in the paper's layout, beside the paper's values),
+``figure_table`` (the tables every page renders alike), ``text`` (the printout),
+``markdown_page`` and ``html_page`` (``README.md`` and ``index.html``, the latter from the Jinja2
+template in ``templates/``, with ``log_chart``'s log-axis bar charts), ``csv_table``
+(``leaderboard.csv``: every shown row), ``doc_tables`` (the results tables of the repository's
+``README.md`` and ``docs/*.md``). The record formats themselves are ``softbench.records``'.
 """
 
 import pathlib
@@ -15,6 +16,7 @@ import pathlib
 from softbench import records
 from softbench import storage
 from softbench.leaderboard import aggregate
+from softbench.leaderboard import csv_table
 from softbench.leaderboard import html_page
 from softbench.leaderboard import markdown_page
 from softbench.leaderboard import ranking
@@ -38,14 +40,16 @@ def write(
   results: pathlib.Path = DEFAULT_RESULTS,
   out: pathlib.Path = DEFAULT_OUT,
 ) -> list[pathlib.Path]:
-  """Writes ``README.md`` and ``index.html`` of ``board`` into ``out`` (atomically); returns
-  their paths. Links to records and videos are relative to ``out``."""
+  """Writes ``README.md``, ``index.html``, ``leaderboard.csv`` and the performance-profile plots
+  of ``board`` into ``out`` (atomically); returns their paths. Links to records and videos are
+  relative to ``out``."""
   out = pathlib.Path(out)
   if out.exists() and not out.is_dir():
     raise ValueError(f"{out}: not a folder; --out takes the folder of the pages")
   pages = {
     "README.md": markdown_page.render(board, results, out),
     "index.html": html_page.render(board, results, out),
+    csv_table.FILE_NAME: csv_table.render(board, out),
   }
   for name, content in pages.items():
     storage.write_atomically(out / name, content)

@@ -42,6 +42,7 @@ class Overview:
   profile: str
   eval_mode: str
   table: Table
+  estimates: dict[tuple[str, str], ranking.Estimate]  # By (agent, task), for the table's cells.
 
   @property
   def title(self) -> str:
@@ -93,7 +94,13 @@ def overviews(board: ranking.Leaderboard) -> tuple[Overview, ...]:
       for agent in names
     )
     tables.append(
-      Overview(robot, profile, eval_mode, Table(caption, ("agent", *tasks), rows, label_columns=1))
+      Overview(
+        robot,
+        profile,
+        eval_mode,
+        Table(caption, ("agent", *tasks), rows, label_columns=1),
+        estimates,
+      )
     )
   return tuple(
     sorted(

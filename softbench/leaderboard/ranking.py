@@ -217,7 +217,7 @@ def rank(loaded: list[tuple[pathlib.Path, dict]]) -> Leaderboard:
   )
 
 
-def _decimals(value: float) -> int:
+def decimals_of(value: float) -> int:
   """2 decimals from 1 up; below 1, enough for 3 significant digits."""
   if value == 0 or abs(value) >= 1:
     return 2
@@ -225,13 +225,13 @@ def _decimals(value: float) -> int:
 
 
 def number(value: float, decimals: int | None = None) -> str:
-  """A figure as the leaderboard prints it, with ``decimals`` (default: ``_decimals(value)``)."""
-  return f"{value:.{_decimals(value) if decimals is None else decimals}f}"
+  """A figure as the leaderboard prints it, with ``decimals`` (default: ``decimals_of(value)``)."""
+  return f"{value:.{decimals_of(value) if decimals is None else decimals}f}"
 
 
 def mean_and_std(estimate: Estimate) -> str:
   """``mean ± std``, both with the decimals of the mean."""
-  decimals = _decimals(estimate.mean)
+  decimals = decimals_of(estimate.mean)
   return f"{number(estimate.mean, decimals)} ± {number(estimate.std, decimals)}"
 
 
@@ -240,7 +240,7 @@ def cell(estimate: Estimate | None) -> str:
   record does not hold."""
   if estimate is None:
     return "-"
-  decimals = _decimals(estimate.mean)
+  decimals = decimals_of(estimate.mean)
   text = mean_and_std(estimate)
   if estimate.interval is not None:
     low, high = estimate.interval
