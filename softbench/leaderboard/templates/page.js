@@ -43,7 +43,10 @@ function applyFilters() {
     board.hidden = !shown;
   });
 }
+// A link can choose them: index.html?profile=default&eval=model.
+var chosen = new URLSearchParams(window.location.search);
 document.querySelectorAll("form.filters input").forEach(function (input) {
+  if (chosen.get(input.name) === input.value) input.checked = true;
   input.addEventListener("change", applyFilters);
 });
 applyFilters();
