@@ -40,7 +40,7 @@ def make(robot, task, **options):
 
 
 def test_every_pair_of_the_suite_is_registered_under_its_id():
-  ids = set(softbench.envs.ENV_IDS)
+  ids = set(softbench.envs.env_ids())
   assert {softbench.envs.env_id(robot, task) for robot, task in suite.ALL_TASKS} <= ids
   assert len(ids) == len(robots.BENCHMARK_ROBOTS) * len(suite.TASKS)
   assert all(gymnasium.spec(env_id).entry_point == softbench.envs.ENTRY_POINT for env_id in ids)

@@ -3,6 +3,7 @@ task (``example_task.py``) each join by one registry line, and then build, train
 through the same code as the built-in ones. Registration is undone after each test."""
 
 import example_task
+import gymnasium
 import numpy as np
 import pytest
 
@@ -13,6 +14,7 @@ from softbench import robots
 from softbench import suite
 from softbench.agents import hyperparameters
 from softbench.agents import learned
+import softbench.envs
 
 ROBOT = "tendon-1"
 
@@ -25,6 +27,10 @@ def restored_registries(monkeypatch):
   monkeypatch.setattr(suite, "_TASKS", dict(suite._TASKS))
   for name in ("TASKS", "ALL_TASKS", "BENCHMARKING"):
     monkeypatch.setattr(suite, name, getattr(suite, name))
+  known_ids = set(gymnasium.registry)
+  yield
+  for added in set(gymnasium.registry) - known_ids:  # The Gymnasium ids of a registered task.
+    del gymnasium.registry[added]
 
 
 def _register_examples() -> None:
@@ -63,10 +69,17 @@ def test_an_example_agent_and_task_join_by_one_line_each(
   assert episode.actions.shape == (5, robots.make(ROBOT).action_dim)
   np.testing.assert_array_equal(episode.targets[0], episode.poses[0])  # The start, held.
   assert np.isfinite(episode.score(robots.make(ROBOT).length).average("position_mm").mean)
+  # softbench.envs was imported before the task was registered, and gives it ids all the same.
+  assert softbench.envs.env_id("tendon-3", "hold") in softbench.envs.env_ids()
+  env = gymnasium.make(softbench.envs.env_id("tendon-3", "hold"), steps=2)
+  observation, _ = env.reset(seed=0)
+  assert env.step(env.action_space.sample())[0].shape == observation.shape
+  env.close()
 
 
 def test_registration_is_undone_between_tests():
   assert "linear" not in agents.AGENTS and "hold" not in suite.TASKS
+  assert softbench.envs.env_id("tendon-3", "hold") not in gymnasium.registry
 
 
 @pytest.mark.parametrize(

@@ -30,18 +30,23 @@ def env_id(robot: str, task: str) -> str:
   return f"{NAMESPACE}/{robot}-{task}-v{VERSION}"
 
 
-ENV_IDS = tuple(env_id(robot, task) for robot in robots.BENCHMARK_ROBOTS for task in suite.TASKS)
-"""Every registered (benchmark robot, task) id, ``custom`` included (it needs ``trajectory=``)."""
+def env_ids() -> tuple[str, ...]:
+  """Every registered (benchmark robot, task) id, ``custom`` included (it needs ``trajectory=``),
+  tasks registered after this module's import too."""
+  return tuple(env_id(robot, task) for robot in robots.BENCHMARK_ROBOTS for task in suite.TASKS)
 
 
-def _register() -> None:
+def _register_task(task: str) -> None:
+  """Registers ``task``'s id on every benchmark robot (once: importing again changes nothing)."""
   for robot in robots.BENCHMARK_ROBOTS:
-    for task in suite.TASKS:
+    if env_id(robot, task) not in gymnasium.registry:
       gymnasium.register(env_id(robot, task), ENTRY_POINT, kwargs={"robot": robot, "task": task})
+
+
+if ANY_ROBOT_ID not in gymnasium.registry:
   gymnasium.register(ANY_ROBOT_ID, ENTRY_POINT)
+for _task in suite.TASKS:
+  _register_task(_task)
+suite.on_register(_register_task)  # A task that suite.register adds later gets its ids too.
 
-
-if env_id(robots.BENCHMARK_ROBOTS[0], suite.TASKS[0]) not in gymnasium.registry:
-  _register()
-
-__all__ = ["ANY_ROBOT_ID", "ENV_IDS", "NAMESPACE", "SoftArmEnv", "env_id"]
+__all__ = ["ANY_ROBOT_ID", "NAMESPACE", "SoftArmEnv", "env_id", "env_ids"]

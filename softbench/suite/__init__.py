@@ -130,6 +130,15 @@ def _pairs() -> tuple[tuple[tuple[str, str], ...], tuple[tuple[str, str], ...]]:
 ALL_TASKS, BENCHMARKING = _pairs()
 
 
+_LISTENERS: list[Callable[[str], None]] = []  # Called with each task registered later.
+
+
+def on_register(listener: Callable[[str], None]) -> None:
+  """Calls ``listener(name)`` for every task that ``register`` adds from now on (so that
+  ``softbench.envs`` gives it Gymnasium ids, whichever of the two is imported first)."""
+  _LISTENERS.append(listener)
+
+
 def register(name: str, entry: TaskEntry) -> None:
   """Adds task ``name`` to the suite (``TASKS``, ``ALL_TASKS`` and ``BENCHMARKING`` are rebound
   to include it): ``entry.build(robot, random=..., **options)`` returns a ``SoftArmTask``.
@@ -146,6 +155,8 @@ def register(name: str, entry: TaskEntry) -> None:
   _TASKS[name] = entry
   TASKS = tuple(_TASKS)
   ALL_TASKS, BENCHMARKING = _pairs()
+  for listener in _LISTENERS:
+    listener(name)
 
 
 def describe(task: str) -> TaskEntry:
