@@ -2,7 +2,6 @@
 one line on stderr and exit code 2, a malformed command line included."""
 
 import argparse
-import json
 import os
 import pathlib
 import sys
@@ -15,6 +14,7 @@ from softbench import agents
 from softbench import continual
 from softbench import data
 from softbench import leaderboard
+from softbench import listings
 from softbench import parallel_seeds
 from softbench import profiles
 from softbench import retrain as retrain_module
@@ -23,9 +23,9 @@ from softbench import run as run_module
 from softbench import saving
 from softbench import storage
 from softbench import suite
+from softbench import terminal
 from softbench import tuning
 from softbench import zoo
-from softbench.agents import hyperparameters
 from softbench.data import dataset
 from softbench.data import seeding
 from softbench.leaderboard import doc_tables
@@ -35,69 +35,43 @@ from softbench.leaderboard import zoo_verification
 from softbench.rendering import options as video_options
 from softbench.rendering import video
 from softbench.robots import export as model_export
+from softbench.zoo import listing as zoo_listing
 
 EXIT_USAGE = 2
 _JSON_HELP = "print JSON (for scripts) instead of a table"
 EXIT_FAILURE = 1  # The run itself failed (not the input).
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it.
+# The video flags (``_add_video_arguments``) by attribute: ``VideoOptions`` fields.
+_VIDEO_OPTIONS = ("width", "height", "fps", "camera", "frames_per_step")
+# The flags of ``softbench run`` that a task's run takes and ``--protocol exp1s`` does not.
+_TASK_RUN_OPTIONS = (
+  "task",
+  "robot",
+  "trajectory",
+  "video",
+  "module",
+  "targets",
+  "helpers",
+  "adaptive",
+  "fault",
+)
+
+
+def _flags_given(args: argparse.Namespace, names: tuple[str, ...]) -> list[str]:
+  """The flags among ``names`` (attributes of ``args``) that the command line set: not left at
+  None, False (a switch) or [] (a repeatable flag)."""
+  unset = lambda value: value is None or value is False or value == []
+  return [f"--{name.replace('_', '-')}" for name in names if not unset(getattr(args, name))]
 
 
 def _robot_overrides(args: argparse.Namespace) -> dict:
   return {"module_length": args.module_length} if args.module_length is not None else {}
 
 
-def _describe(robot: robots.SoftArm) -> str:
-  return (
-    f"{robot.name:<15} {robot.num_modules:>7} {robot.action_dim:>10} "
-    f"{robot.length * 1000:>9.0f} {robot.mass() * 1000:>8.1f}"
-  )
-
-
-def _robot_facts(robot: robots.SoftArm) -> dict:
-  """What ``softbench robots --json`` tells of ``robot`` (SI units)."""
-  return {
-    "name": robot.name,
-    "modules": robot.num_modules,
-    "action_dim": robot.action_dim,
-    "actuators_per_module": list(robot.actuators_per_module),
-    "length_m": robot.length,
-    "mass_kg": robot.mass(),
-    "control_period_s": robot.control_timestep,
-  }
-
-
-def _print_json(document) -> None:
-  print(json.dumps(document, indent=2, allow_nan=False))
-
-
 def _robots(args: argparse.Namespace) -> None:
-  header = f"{'robot':<15} {'modules':>7} {'action dim':>10} {'length mm':>9} {'mass g':>8}"
-  if args.name is None:
-    listed = [robots.make(name, **_robot_overrides(args)) for name in robots.BENCHMARK_ROBOTS]
-    if args.json:
-      _print_json([_robot_facts(robot) for robot in listed])
-      return
-    print(header)
-    for robot in listed:
-      print(_describe(robot))
-    return
-  robot = robots.make(args.name, **_robot_overrides(args))
   if args.json:
-    _print_json(
-      {
-        **_robot_facts(robot),
-        "spec": {field: value for field, value in model_export.spec_fields(robot)},
-      }
-    )
-    return
-  print(header)
-  print(_describe(robot))
-  print(
-    f"\ncontrol period: {robot.control_timestep} s; actions per module: "
-    f"{', '.join(map(str, robot.actuators_per_module))}"
-  )
-  for field, value in model_export.spec_fields(robot):
-    print(f"  {field} = {value}")
+    return terminal.print_json(listings.robots_document(args.name, **_robot_overrides(args)))
+  terminal.show(listings.robots_table(args.name, **_robot_overrides(args)))
 
 
 def _models_export(args: argparse.Namespace) -> None:
@@ -110,201 +84,57 @@ def _models_export(args: argparse.Namespace) -> None:
 
 def _tasks(args: argparse.Namespace) -> None:
   if args.json:
-    _print_json(
-      [
-        {
-          "name": task,
-          "tags": list(suite.describe(task).tags),
-          "description": suite.describe(task).description,
-          "benchmark_robots": [robot for robot, name in suite.ALL_TASKS if name == task],
-        }
-        for task in suite.TASKS
-      ]
-    )
-    return
-  print(f"{'task':<10} {'tags':<24} description")
-  for task in suite.TASKS:
-    entry = suite.describe(task)
-    print(f"{task:<10} {', '.join(entry.tags):<24} {entry.description}")
-  periods = sorted(
-    {(robots.make(name).control_timestep, name.split("-")[0]) for name in robots.BENCHMARK_ROBOTS},
-    key=lambda item: item[1],
-  )
-  print(
-    "\ncontrol period: "
-    + "; ".join(f"{family} arms {period:g} s ({1 / period:g} Hz)" for period, family in periods)
-  )
-  print(
-    f"{len(suite.ALL_TASKS)} (robot, task) pairs on the benchmark robots "
-    f"({', '.join(robots.BENCHMARK_ROBOTS)}); every task runs on any robot"
-  )
+    return terminal.print_json(listings.tasks_document())
+  terminal.show(listings.tasks_table())
 
 
 def _collect(args: argparse.Namespace) -> None:
   collected = data.collect(args.robot, samples=args.samples, seed=args.seed, workers=args.workers)
-  seconds = collected.collection.get("wall_time_s")
-  print(
-    f"{collected.robot_name}: {collected.samples} samples in {collected.num_episodes} episodes"
-    + (f" (collection took {seconds:.1f} s)" if seconds is not None else "")
-  )
+  print(collected.describe())
   print(collected.path)
 
 
 def _agents(args: argparse.Namespace) -> None:
   if args.json:
-    tuned = hyperparameters.load()["agents"]
-    _print_json(
-      [
-        {
-          "name": name,
-          "learned": agents.describe(name).learned,
-          "description": agents.describe(name).description,
-          "hyperparameters": {
-            robot: values["params"] for robot, values in tuned.get(name, {}).items()
-          },
-        }
-        for name in agents.AGENTS
-      ]
-    )
-    return
-  print(f"{'agent':<10} {'learns':<7} description")
-  for name in agents.AGENTS:
-    entry = agents.describe(name)
-    print(f"{name:<10} {'yes' if entry.learned else 'no':<7} {entry.description}")
-    if args.verbose and entry.learned:
-      for robot, values in hyperparameters.load()["agents"].get(name, {}).items():
-        study = values["study"]
-        origin = "not tuned"
-        if study is not None:
-          origin = (
-            f"best of {sum(study['trials'].values())} trials on the {study['profile']} "
-            f"profile: validation MSE {_loss(study['best']['value'])} after "
-            f"{study['trial_epochs']} epochs"
-          )
-          if "full_budget" in study:
-            origin += f", {_loss(study['full_budget']['best'])} after {study['max_epochs']}"
-        settings = ", ".join(f"{key} {value:g}" for key, value in values["params"].items())
-        print(f"{'':<18} {robot}: {settings} ({origin})")
-
-
-def _loss(value: float | None) -> str:
-  return "not finite" if value is None else f"{value:.4g}"
+    return terminal.print_json(listings.agents_document())
+  terminal.show(listings.agents_table(args.verbose))
 
 
 def _tune(args: argparse.Namespace) -> None:
   settings = tuning.settings(
     args.agent, args.robot, args.trials, args.storage, args.profile, args.study, args.epochs
   )
-  summary = tuning.run(settings)
-  if args.confirm:
-    summary = tuning.confirm(settings, summary)
-  best, previous = summary["best"], summary["previous_values"]
-  trials = summary["trials"]
-  print(
-    f"{settings.agent} on {settings.robot}, profile {settings.profile.name}: "
-    f"{trials['complete']} complete, {trials['pruned']} pruned, {trials['fail']} failed"
-  )
-  if previous is not None:
-    print(f"previous values (trial {previous['trial']}): validation MSE {_loss(previous['value'])}")
-  if best is not None:
-    print(f"best trial {best['trial']}: validation MSE {_loss(best['value'])}")
-    for key, value in best["params"].items():
-      print(f"  {key} = {value:g}")
-  if "full_budget" in summary:
-    check = summary["full_budget"]
-    print(
-      f"at the profile's {check['epochs']} epochs: previous values "
-      f"{_loss(check['previous'])}, best {_loss(check['best'])}"
-    )
-  path = pathlib.Path(args.summary) if args.summary else tuning.summary_path(settings)
-  tuning.write_summary(summary, path)
-  print(f"study summary: {path}")
-  if args.adopt:
-    tuning.adopt(summary)
-    print(f"adopted as {settings.agent}'s values on {settings.robot}: {hyperparameters.PATH}")
+  tuning.tune(settings, args.confirm, args.summary, args.adopt)
 
 
 def _run_protocol(args: argparse.Namespace) -> None:
-  if args.protocol != continual.PROTOCOL:
-    raise ValueError(
-      f"unknown protocol {args.protocol!r}; {continual.PROTOCOL} is the one with a "
-      f"table of its own (exp2s and exp2r are the tasks on tendon-3 and "
-      f"pneumatic-433: softbench run --task TASK --agent AGENT)"
-    )
-  if args.agent != "smpl":
-    raise ValueError(
-      f"--protocol {args.protocol} trains SMPL's columns in sequence; it takes "
-      f"--agent smpl, got {args.agent!r}"
-    )
-  given = [
-    flag
-    for flag, value in (
-      ("--task", args.task),
-      ("--robot", args.robot),
-      ("--trajectory", args.trajectory),
-      ("--video", args.video),
-      ("--module", args.module),
-      ("--targets", args.targets),
-      ("--helpers", args.helpers),
-    )
-    if value is not None
-  ]
-  given += (["--adaptive"] if args.adaptive else []) + (["--fault"] if args.fault else [])
-  if given or args.eval != "physics":
-    raise ValueError(
-      f"--protocol {args.protocol} fixes its robots, tasks and loops; drop "
-      f"{', '.join(given) or '--eval'}"
-    )
-  profile = profiles.get(args.profile)
-  family = args.family or continual.DEFAULT_FAMILY
-  continual.protocol(family)  # Checked before anything runs.
+  settings = continual.settings(
+    args.protocol,
+    args.agent,
+    args.profile,
+    args.family,
+    args.seeds,
+    args.eval,
+    _flags_given(args, _TASK_RUN_OPTIONS),
+  )
   record = continual.execute(
-    profile, args.seeds, workers=args.workers, keep_seeds=True, family=family
+    settings.profile, settings.seeds, workers=args.workers, keep_seeds=True, family=settings.family
   )
   files = saving.save(continual, record, pathlib.Path(args.results), _json_copy(args))
   continual.finish(record, files)
 
 
-def _number(name: str, text: str, kind: type) -> int | float:
-  try:
-    return kind(text)
-  except ValueError:
-    raise ValueError(f"{name} must be a number, got {text!r}") from None
-
-
-# The video flags (``_add_video_arguments``), their attributes and defaults.
-_VIDEO_FLAGS = (
-  ("--width", "width", str(video_options.DEFAULT_WIDTH)),
-  ("--height", "height", str(video_options.DEFAULT_HEIGHT)),
-  ("--fps", "fps", f"{video_options.DEFAULT_FPS:g}"),
-  ("--camera", "camera", video_options.DEFAULT_CAMERA),
-  ("--frames-per-step", "frames_per_step", "1"),
-)
-
-
-def _video_options(args: argparse.Namespace) -> video_options.VideoOptions:
-  given = {
-    name: default if getattr(args, name) is None else getattr(args, name)
-    for _, name, default in _VIDEO_FLAGS
-  }
-  return video_options.VideoOptions(
-    _number("width", given["width"], int),
-    _number("height", given["height"], int),
-    _number("fps", given["fps"], float),
-    given["camera"],
-    _number("frames per step", given["frames_per_step"], int),
-  )
-
-
-def _video_flags_given(args: argparse.Namespace) -> list[str]:
-  return [flag for flag, name, _ in _VIDEO_FLAGS if getattr(args, name) is not None]
+def _video_request(args: argparse.Namespace, path: str) -> run_module.VideoRequest:
+  """A video of the options the video flags give, to ``path``; both checked."""
+  options = video_options.from_text(**{name: getattr(args, name) for name in _VIDEO_OPTIONS})
+  return run_module.VideoRequest(video_options.check_video_path(path), options)
 
 
 def _run(args: argparse.Namespace) -> None:
-  if args.video is None and _video_flags_given(args):
-    given = _video_flags_given(args)
+  video_flags = _flags_given(args, _VIDEO_OPTIONS)
+  if args.video is None and video_flags:
     raise ValueError(
-      f"{', '.join(given)} {'goes' if len(given) == 1 else 'go'} with --video FILE.mp4"
+      f"{', '.join(video_flags)} {'goes' if len(video_flags) == 1 else 'go'} with --video FILE.mp4"
     )
   _check_record_arguments(args)
   if args.workers is not None:  # Before any collection or training starts.
@@ -331,30 +161,24 @@ def _run(args: argparse.Namespace) -> None:
   )
   if args.video and settings.adaptive:
     raise ValueError("--video renders one seed's episode; --adaptive draws its own figure")
-  video_request = None
-  if args.video:
-    video_request = run_module.VideoRequest(
-      video_options.check_video_path(args.video), _video_options(args)
-    )
+  video_request = _video_request(args, args.video) if args.video else None
   record, episodes = run_module.execute_episodes(settings, keep_seeds=True, workers=args.workers)
   files = saving.save(run_module, record, pathlib.Path(args.results), _json_copy(args))
   run_module.finish(settings, record, files, episodes, video_request)
 
 
 def _render(args: argparse.Namespace) -> None:
-  options = _video_options(args)
-  path = video_options.check_video_path(args.out)
-  seed = _number("seed", args.seed, int)
+  request = _video_request(args, args.out)
+  seed = video_options.parse_number("seed", args.seed, int)
   seeding.check_seed(seed)
   settings = run_module.settings(
     args.task, args.agent, args.robot, 1, args.profile, args.eval, args.trajectory
   )
-  episode = run_module.seed_episode(settings, seed, show_progress=True)
-  run_module.write_video(settings, seed, episode, run_module.VideoRequest(path, options))
+  run_module.render_seed(settings, seed, request)
 
 
 def _add_video_arguments(parser: argparse.ArgumentParser) -> None:
-  """The flags of ``_VIDEO_FLAGS``; left out, they are None (``_video_options`` fills in)."""
+  """The flags of ``_VIDEO_OPTIONS``; left out, they are None (``from_text`` takes the default)."""
   parser.add_argument(
     "--width", help=f"frame width in pixels, even (default {video_options.DEFAULT_WIDTH})"
   )
@@ -432,93 +256,26 @@ def _retrain(args: argparse.Namespace) -> None:
   saving.save(retrain_module, record, pathlib.Path(args.results), _json_copy(args))
 
 
-def _zoo_folder(args: argparse.Namespace, create: bool = False) -> pathlib.Path:
-  """The zoo a ``softbench zoo`` command works on: ``--zoo``, else the one in use."""
-  chosen = pathlib.Path(args.zoo) if args.zoo else zoo.location()
-  if chosen is None:
-    raise ValueError(f"the zoo is turned off (${zoo.VARIABLE}={zoo.OFF}); name one with --zoo DIR")
-  if create:
-    return storage.check_writable(chosen, "the zoo", folder=True)
-  if not chosen.is_dir():
-    raise ValueError(
-      f"no zoo at {chosen}: not a folder (name one with --zoo DIR or ${zoo.VARIABLE})"
-    )
-  return chosen
-
-
 def _zoo_list(args: argparse.Namespace) -> None:
-  folder = _zoo_folder(args)
-  entries = zoo.read_manifest(folder)
-  print(f"{'kind':<15} {'KiB':>8} {'records':>7}  path")
-  for path, entry in sorted(entries.items()):
-    print(f"{entry.kind:<15} {entry.bytes / 1024:>8.1f} {len(entry.records):>7}  {path}")
-  print(
-    f"{len(entries)} files, {zoo.size_bytes(entries) / 2**20:.1f} MiB of "
-    f"{zoo.BUDGET_BYTES / 2**20:.0f} MiB ({folder})"
-  )
-  for problem in zoo.check_files(folder):
-    print(f"problem: {problem}")
+  terminal.show(zoo_listing.contents(zoo.chosen_folder(args.zoo)))
 
 
 def _zoo_add(args: argparse.Namespace) -> None:
-  family = None
-  if args.protocol is not None:
-    if args.protocol != continual.PROTOCOL:
-      raise ValueError(f"unknown protocol {args.protocol!r}; the zoo keeps {continual.PROTOCOL}'s")
-    family = args.family or continual.DEFAULT_FAMILY
-  elif args.family is not None:
-    raise ValueError(f"--family goes with --protocol {continual.PROTOCOL}")
-  chosen = zoo_catalogue.setting(args.agent, args.robot, family, args.profile, args.seeds)
-  folder = _zoo_folder(args, create=True)
-  linked = zoo_catalogue.records_of(chosen, pathlib.Path(args.results))
-  files = zoo_catalogue.cache_files(chosen)
-  added, skipped = zoo.add(
-    [(path, kind) for _, path, kind in files],
-    {path: linked[seed] for seed, path, kind in files if kind == "agent"},
-    folder,
+  chosen = zoo_catalogue.requested_setting(
+    args.agent, args.robot, args.protocol, args.family, args.profile, args.seeds
   )
-  for entry in added:
-    print(
-      f"added {entry.path} ({entry.kind}, {entry.bytes / 1024:.1f} KiB, "
-      f"{len(entry.records)} records)"
-    )
-  for path in skipped:
-    print(f"skipped {path.name}: its training has not started in the data home")
-  print(
-    f"zoo: {zoo.size_bytes(zoo.read_manifest(folder)) / 2**20:.1f} MiB of "
-    f"{zoo.BUDGET_BYTES / 2**20:.0f} MiB ({folder})"
-  )
+  folder = zoo.chosen_folder(args.zoo, create=True)
+  added, skipped = zoo_catalogue.add(chosen, pathlib.Path(args.results), folder)
+  print(zoo_listing.additions(added, skipped, folder))
 
 
 def _zoo_verify(args: argparse.Namespace) -> None:
-  folder = _zoo_folder(args)
-  for name in args.agents or ():
-    agents.describe(name)
-  problems = zoo.check_files(folder)
-  if problems:
-    raise ValueError(f"{folder}: {problems[0]} ({len(problems)} problems; see softbench zoo list)")
-
-  def report(check) -> None:
-    verdict = "identical" if check.identical else f"DIFFERS: {check.detail}"
-    print(f"{check.record} seed {check.seed}: {verdict} ({check.seconds:.1f} s)", flush=True)
-
-  checks = zoo_verification.verify(
+  zoo_verification.verify_zoo(
     pathlib.Path(args.results),
-    folder,
+    zoo.chosen_folder(args.zoo),
     tuple(args.agents) if args.agents else None,
     args.quick,
-    report,
   )
-  differing = [check for check in checks if not check.identical]
-  print(
-    f"{len(checks) - len(differing)} of {len(checks)} re-scored seeds identical to their records"
-  )
-  if differing:
-    raise ZooMismatch(f"{len(differing)} re-scored seeds differ from their records")
-
-
-class ZooMismatch(RuntimeError):
-  """``softbench zoo verify`` found a record that the zoo's weights do not reproduce."""
 
 
 _FAULT_HELP = (
@@ -855,7 +612,7 @@ def main(argv: list[str] | None = None) -> int:
     parallel_seeds.WorkerDied,
     video.RenderingFailed,
     continual.ForgettingDetected,
-    ZooMismatch,
+    zoo_verification.ZooMismatch,
   ) as error:
     print(f"softbench: error: {dataset.first_line(error)}", file=sys.stderr)
     return EXIT_FAILURE

@@ -17,6 +17,7 @@ once the model-level matrix shows every earlier column's score unchanged, to the
 every later stage. A changed score would be forgetting, and raises.
 """
 
+from collections.abc import Sequence
 import dataclasses
 import hashlib
 import pathlib
@@ -64,6 +65,54 @@ def protocol(family: str = DEFAULT_FAMILY) -> protocols.Protocol:
       f"unknown tendon family {family!r}; choose one of {', '.join(robots.TENDON_FAMILIES)}"
     )
   return protocols.get(PROTOCOL).on_family(family)
+
+
+@dataclasses.dataclass(frozen=True)
+class RunSettings:
+  """A checked Exp1S run (``softbench run --protocol exp1s``)."""
+
+  profile: profiles.Profile
+  family: str
+  seeds: int | None = None  # None: the profile's.
+
+
+def settings(
+  protocol_name: str,
+  agent: str,
+  profile: str = profiles.DEFAULT_PROFILE,
+  family: str | None = None,
+  seeds: int | None = None,
+  eval_mode: str = "physics",
+  task_options: Sequence[str] = (),
+) -> RunSettings:
+  """Checked settings of ``softbench run --protocol``: Exp1S fixes its robots, tasks and loops,
+  so it takes agent smpl, the physics eval mode and none of a task run's options
+  (``task_options``: the flags given, e.g. ``--task``).
+
+  Raises:
+    ValueError: another protocol or agent, a task run's option, another eval mode, an unknown
+      profile or family (one line).
+  """
+  if protocol_name != PROTOCOL:
+    raise ValueError(
+      f"unknown protocol {protocol_name!r}; {PROTOCOL} is the one with a table of its own "
+      f"(exp2s and exp2r are the tasks on tendon-3 and pneumatic-433: softbench run --task TASK "
+      f"--agent AGENT)"
+    )
+  if agent != "smpl":
+    raise ValueError(
+      f"--protocol {PROTOCOL} trains SMPL's columns in sequence; it takes --agent smpl, "
+      f"got {agent!r}"
+    )
+  if task_options or eval_mode != "physics":
+    raise ValueError(
+      f"--protocol {PROTOCOL} fixes its robots, tasks and loops; drop "
+      f"{', '.join(task_options) or '--eval'}"
+    )
+  chosen = profiles.get(profile)
+  family = family or DEFAULT_FAMILY
+  protocol(family)
+  return RunSettings(chosen, family, seeds)
 
 
 @dataclasses.dataclass(frozen=True)

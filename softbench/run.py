@@ -186,6 +186,12 @@ def write_video(
   print(stats.describe(request.options))
 
 
+def render_seed(run: RunSettings, seed: int, request: VideoRequest) -> None:
+  """``softbench render``: trains (or reuses) seed ``seed``'s agent, runs its episode with a
+  progress bar and renders it as ``request`` asks."""
+  write_video(run, seed, seed_episode(run, seed, show_progress=True), request)
+
+
 def finish(
   run: RunSettings,
   record: dict,

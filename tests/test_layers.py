@@ -1,6 +1,6 @@
 """The package's layers import one way: no cycle among softbench's units (its subpackages and
 top-level modules), counting every import statement, deferred ones too; and the agent registry,
-the records and the leaderboard import without torch."""
+the records, the leaderboard and the listings of the command line import without torch."""
 
 import ast
 import pathlib
@@ -104,6 +104,7 @@ def test_the_cycle_finder_finds_a_cycle():
     "softbench.agents, softbench.agents.hyperparameters",
     "softbench.records, softbench.records.exp1s, softbench.records.provenance",
     "softbench.leaderboard, softbench.leaderboard.html_page, softbench.leaderboard.overview",
+    "softbench.listings, softbench.terminal",
   ],
 )
 def test_the_registries_and_the_records_import_without_torch(modules):

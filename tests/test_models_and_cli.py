@@ -113,6 +113,16 @@ def test_cli_lists_robots_tasks_and_agents_as_json(capsys):
     )
 
 
+def test_cli_tables_are_plain_lines_when_piped(capsys):
+  # capsys is not a terminal: one line a row however long, no escape codes, no trailing spaces.
+  assert cli.main(["agents", "--verbose"]) == 0
+  lines = capsys.readouterr().out.splitlines()
+  tuned = hyperparameters.load()["agents"]
+  learned = [name for name in agents.AGENTS if agents.describe(name).learned]
+  assert len(lines) == 1 + len(agents.AGENTS) + sum(len(tuned.get(name, {})) for name in learned)
+  assert all(line == line.rstrip() and "\x1b" not in line for line in lines)
+
+
 def test_cli_describes_any_valid_tendon_arm(capsys):
   assert cli.main(["robots", "tendon-7"]) == 0
   assert capsys.readouterr().out.splitlines()[1].split()[:3] == ["tendon-7", "7", "14"]

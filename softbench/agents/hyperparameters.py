@@ -116,3 +116,24 @@ def adopt(
   check_params(agent, params)
   table["agents"].setdefault(agent, {})[robot] = {"params": dict(params), "study": study}
   storage.write_atomically(path, json.dumps(table, indent=2, allow_nan=False) + "\n")
+
+
+def loss_text(value: float | None) -> str:
+  """A validation MSE as reports show it; None is a loss that was not finite."""
+  return "not finite" if value is None else f"{value:.4g}"
+
+
+def describe_entry(entry: dict) -> str:
+  """An ``entry``'s values and where they come from, in one line: ``learning_rate 0.001, ...
+  (best of 10 trials on the default profile: validation MSE ...)`` or ``(... not tuned)``."""
+  study = entry["study"]
+  origin = "not tuned"
+  if study is not None:
+    origin = (
+      f"best of {sum(study['trials'].values())} trials on the {study['profile']} profile: "
+      f"validation MSE {loss_text(study['best']['value'])} after {study['trial_epochs']} epochs"
+    )
+    if "full_budget" in study:
+      origin += f", {loss_text(study['full_budget']['best'])} after {study['max_epochs']}"
+  settings = ", ".join(f"{name} {value:g}" for name, value in entry["params"].items())
+  return f"{settings} ({origin})"

@@ -106,6 +106,12 @@ class Dataset:
   def action_dim(self) -> int:
     return self.actions.shape[1]
 
+  def describe(self) -> str:
+    """One line: ``tendon-3: 14000 samples in 10 episodes (collection took 61.2 s)``."""
+    seconds = self.collection.get("wall_time_s")
+    took = "" if seconds is None else f" (collection took {seconds:.1f} s)"
+    return f"{self.robot_name}: {self.samples} samples in {self.num_episodes} episodes{took}"
+
   def episode(self, index: int) -> tuple[np.ndarray, np.ndarray]:
     """Poses (L + 1, num_modules, 6) and actions (L, action_dim) of episode ``index``."""
     if not 0 <= index < self.num_episodes:

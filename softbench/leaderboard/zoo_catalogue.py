@@ -1,5 +1,5 @@
 """What the zoo keeps for a setting: the cache files of a learned agent's seeds (or of Exp1S's
-networks), and the committed records each of them stands behind."""
+networks), the committed records each of them stands behind, and adding them to the zoo."""
 
 import dataclasses
 import pathlib
@@ -9,6 +9,7 @@ from softbench import continual
 from softbench import profiles
 from softbench import records
 from softbench import robots
+from softbench import zoo
 from softbench.agents import learned
 
 
@@ -66,6 +67,30 @@ def setting(
   return Setting(chosen, seeds, agent=agent, robot=robot)
 
 
+def requested_setting(
+  agent: str | None,
+  robot: str | None,
+  protocol: str | None,
+  family: str | None,
+  profile: str,
+  seeds: int | None,
+) -> Setting:
+  """The ``setting`` that ``softbench zoo add`` names: ``agent`` on ``robot``, or ``protocol``
+  (Exp1S) on ``family`` (default ``continual.DEFAULT_FAMILY``).
+
+  Raises:
+    ValueError: another protocol, a family without the protocol, or what ``setting`` refuses
+      (one line).
+  """
+  if protocol is not None:
+    if protocol != continual.PROTOCOL:
+      raise ValueError(f"unknown protocol {protocol!r}; the zoo keeps {continual.PROTOCOL}'s")
+    family = family or continual.DEFAULT_FAMILY
+  elif family is not None:
+    raise ValueError(f"--family goes with --protocol {continual.PROTOCOL}")
+  return setting(agent, robot, family, profile, seeds)
+
+
 def cache_files(chosen: Setting) -> list[tuple[int, pathlib.Path, str]]:
   """(seed, cache file, zoo kind) of every file the setting's training writes to the data
   home: each seed's checkpoint, then (for an agent) its forward models."""
@@ -108,3 +133,17 @@ def records_of(chosen: Setting, results: pathlib.Path) -> dict[int, list[str]]:
     seed: [path.name for path, record in found if stands_behind(record, chosen, seed)]
     for seed in range(chosen.seeds)
   }
+
+
+def add(
+  chosen: Setting, results: pathlib.Path, zoo_folder: pathlib.Path
+) -> tuple[list[zoo.Entry], list[pathlib.Path]]:
+  """``zoo.add`` of the setting's cache files, each seed's checkpoint linked to the records in
+  ``results`` that it stands behind; returns the entries added and the cache files skipped."""
+  linked = records_of(chosen, results)
+  files = cache_files(chosen)
+  return zoo.add(
+    [(path, kind) for _, path, kind in files],
+    {path: linked[seed] for seed, path, kind in files if kind == "agent"},
+    zoo_folder,
+  )

@@ -1,5 +1,6 @@
 """``softbench zoo verify``: re-scores committed records from the zoo's weights alone, in an
-empty data home, and compares every figure with the record's."""
+empty data home, and compares every figure with the record's (``verify``; ``verify_zoo`` checks
+the zoo first and prints what it finds)."""
 
 from collections.abc import Iterator
 import contextlib
@@ -10,6 +11,7 @@ import pathlib
 import tempfile
 import time
 
+from softbench import agents as agent_registry
 from softbench import continual
 from softbench import profiles
 from softbench import records
@@ -28,6 +30,15 @@ class Check:
   identical: bool
   detail: str  # What differs, or how the record could not be re-scored; '' when identical.
   seconds: float
+
+  def describe(self) -> str:
+    """One line: ``RECORD seed N: identical (12.3 s)``, or ``DIFFERS: ...`` and what differs."""
+    verdict = "identical" if self.identical else f"DIFFERS: {self.detail}"
+    return f"{self.record} seed {self.seed}: {verdict} ({self.seconds:.1f} s)"
+
+
+class ZooMismatch(RuntimeError):
+  """``softbench zoo verify`` found a record that the zoo's weights do not reproduce."""
 
 
 @contextlib.contextmanager
@@ -139,4 +150,35 @@ def verify(
     checks.append(check)
     if report is not None:
       report(check)
+  return checks
+
+
+def verify_zoo(
+  results: pathlib.Path,
+  zoo_folder: pathlib.Path,
+  agents: tuple[str, ...] | None = None,
+  quick: bool = False,
+) -> list[Check]:
+  """``softbench zoo verify``: checks the agents' names and the zoo's files, then ``verify``s,
+  printing each check as it ends and then the tally.
+
+  Raises:
+    ValueError: an unknown agent, or a zoo file missing, damaged or unlisted (one line, before
+      anything is re-scored).
+    ZooMismatch: a re-scored seed differs from its record.
+  """
+  for name in agents or ():
+    agent_registry.describe(name)
+  problems = zoo.check_files(zoo_folder)
+  if problems:
+    raise ValueError(
+      f"{zoo_folder}: {problems[0]} ({len(problems)} problems; see softbench zoo list)"
+    )
+  checks = verify(
+    results, zoo_folder, agents, quick, lambda check: print(check.describe(), flush=True)
+  )
+  differing = sum(not check.identical for check in checks)
+  print(f"{len(checks) - differing} of {len(checks)} re-scored seeds identical to their records")
+  if differing:
+    raise ZooMismatch(f"{differing} re-scored seeds differ from their records")
   return checks

@@ -1,5 +1,6 @@
-"""What a video looks like (size, frame rate, camera, frames per control step), checked up front,
-and where it may be written: bad input is refused before anything runs."""
+"""What a video looks like (size, frame rate, camera, frames per control step), checked up front
+(``from_text`` reads them from a command line), and where it may be written: bad input is
+refused before anything runs."""
 
 import dataclasses
 import math
@@ -77,6 +78,32 @@ class VideoOptions:
   def frame_count(self, steps: int) -> int:
     """Frames of an episode of ``steps`` control steps: the start, then frames_per_step each."""
     return 1 + steps * self.frames_per_step
+
+
+def parse_number(name: str, text: str, kind: type) -> int | float:
+  """``text`` (a command line's) as a number of type ``kind``; a one-line ValueError naming
+  ``name`` otherwise."""
+  try:
+    return kind(text)
+  except ValueError:
+    raise ValueError(f"{name} must be a number, got {text!r}") from None
+
+
+def from_text(**given: str | None) -> VideoOptions:
+  """Checked ``VideoOptions`` from command-line text, by field name (``width="640"``); a field
+  given as None keeps its default.
+
+  Raises:
+    ValueError: a field that is not a number where one is needed, or out of range (one line).
+  """
+  kinds = {field.name: field.type for field in dataclasses.fields(VideoOptions)}
+  return VideoOptions(
+    **{
+      name: text if kinds[name] is str else parse_number(name.replace("_", " "), text, kinds[name])
+      for name, text in given.items()
+      if text is not None
+    }
+  )
 
 
 def check_video_path(path: str | os.PathLike) -> pathlib.Path:

@@ -3,7 +3,8 @@
 ``settings(...)`` checks a study's settings, ``run(settings)`` adds trials until the budget is
 spent and returns the study's summary, ``confirm`` trains its previous and best values at the
 profile's full epoch budget, ``write_summary`` saves it and ``adopt`` commits the best values as
-the agent's hyperparameters (``softbench.agents.hyperparameters``). See
+the agent's hyperparameters (``softbench.agents.hyperparameters``); ``tune`` does all of it as
+``softbench tune`` asks and prints the report (``softbench.tuning.report``). See
 ``softbench.tuning.study`` for the objective, sampler and pruner.
 """
 
@@ -15,6 +16,7 @@ from softbench.tuning.study import default_storage
 from softbench.tuning.study import run
 from softbench.tuning.study import settings
 from softbench.tuning.study import summary_path
+from softbench.tuning.study import tune
 from softbench.tuning.study import write_summary
 
 __all__ = [
@@ -26,5 +28,6 @@ __all__ = [
   "run",
   "settings",
   "summary_path",
+  "tune",
   "write_summary",
 ]

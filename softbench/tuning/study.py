@@ -25,6 +25,7 @@ import datetime
 import hashlib
 import json
 import math
+import os
 import pathlib
 
 import optuna
@@ -38,6 +39,7 @@ from softbench import robots
 from softbench import storage
 from softbench.agents import hyperparameters
 from softbench.agents import learned
+from softbench.tuning import report
 
 DEFAULT_TRIALS = 10  # Trials per study, the same for every agent (docs/tuning.md: budget).
 DATABASE = "tuning.db"  # Default SQLite storage, under the data home.
@@ -293,6 +295,28 @@ def summary(study: optuna.Study, settings: TuneSettings) -> dict:
       for trial in study.trials
     ],
   }
+
+
+def tune(
+  settings: TuneSettings,
+  confirm_budget: bool = False,
+  summary_file: str | os.PathLike | None = None,
+  adopt_best: bool = False,
+) -> dict:
+  """``softbench tune``: ``run``s the study (then ``confirm``s it if ``confirm_budget``), prints
+  its report, writes its summary (to ``summary_file``, else ``summary_path``) and, if
+  ``adopt_best``, ``adopt``s its best values; returns the summary."""
+  study_summary = run(settings)
+  if confirm_budget:
+    study_summary = confirm(settings, study_summary)
+  print(report.summary_text(study_summary))
+  path = pathlib.Path(summary_file) if summary_file else summary_path(settings)
+  write_summary(study_summary, path)
+  print(f"study summary: {path}")
+  if adopt_best:
+    adopt(study_summary)
+    print(f"adopted as {settings.agent}'s values on {settings.robot}: {hyperparameters.PATH}")
+  return study_summary
 
 
 def summary_path(settings: TuneSettings) -> pathlib.Path:

@@ -17,9 +17,10 @@ model is trained instead. Everything else (checking the configuration, the weigh
 the cache's usual loading.
 
 The zoo is ``$SOFTBENCH_ZOO`` if set (``none`` turns it off), else the ``zoo/`` folder of the
-source checkout softbench runs from. Which records each file stands behind, and re-scoring them
-from the zoo alone, belong to the leaderboard (``leaderboard.zoo_catalogue``,
-``leaderboard.zoo_verification``).
+source checkout softbench runs from (``chosen_folder``: the one a ``softbench zoo`` command works
+on). Which records each file stands behind, and re-scoring them from the zoo alone, belong to the
+leaderboard (``leaderboard.zoo_catalogue``, ``leaderboard.zoo_verification``); what
+``softbench zoo list`` and ``zoo add`` print, to ``zoo.listing``.
 """
 
 import dataclasses
@@ -79,6 +80,23 @@ def folder() -> pathlib.Path | None:
   """The zoo in use: ``location()`` if it is a folder, else None."""
   path = location()
   return path if path is not None and path.is_dir() else None
+
+
+def chosen_folder(given: str | os.PathLike | None = None, create: bool = False) -> pathlib.Path:
+  """The zoo a ``softbench zoo`` command works on: ``given`` (its ``--zoo``), else ``location()``;
+  an existing folder, or with ``create`` one that can be made or written.
+
+  Raises:
+    ValueError: the zoo is turned off, or is not a folder (one line).
+  """
+  chosen = pathlib.Path(given) if given else location()
+  if chosen is None:
+    raise ValueError(f"the zoo is turned off (${VARIABLE}={OFF}); name one with --zoo DIR")
+  if create:
+    return storage.check_writable(chosen, "the zoo", folder=True)
+  if not chosen.is_dir():
+    raise ValueError(f"no zoo at {chosen}: not a folder (name one with --zoo DIR or ${VARIABLE})")
+  return chosen
 
 
 def file_sha256(path: pathlib.Path) -> str:

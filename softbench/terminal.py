@@ -1,0 +1,46 @@
+"""Output of the command line: tables for people (rich), which read as plain lines when piped, and
+JSON documents for scripts."""
+
+from collections.abc import Collection
+from collections.abc import Iterable
+from collections.abc import Sequence
+import json
+import sys
+
+from rich.console import Console
+from rich.console import RenderableType
+from rich.table import Table
+
+PIPED_WIDTH = 10_000  # (characters) Line width when stdout is not a terminal: no row wraps.
+
+
+def table(
+  columns: Sequence[str], rows: Iterable[Sequence[str]], right: Collection[str] = ()
+) -> Table:
+  """``rows`` under the headers ``columns``, in the one table style of softbench: a bold header,
+  no borders, columns two spaces apart; the columns named in ``right`` (numbers) right-aligned."""
+  shown = Table(box=None, pad_edge=False)
+  for column in columns:
+    shown.add_column(column, justify="right" if column in right else "left")
+  for row in rows:
+    shown.add_row(*row)
+  return shown
+
+
+def show(renderable: RenderableType) -> None:
+  """Prints ``renderable`` (a table, text, a ``rich.console.Group`` of them) on stdout, text as
+  it is (no markup). On a terminal rich fits it to the width; piped, each row is one line without
+  trailing spaces."""
+  console = Console(file=sys.stdout, markup=False, highlight=False, emoji=False)
+  if console.is_terminal:
+    console.print(renderable)
+    return
+  console.width = PIPED_WIDTH
+  with console.capture() as captured:
+    console.print(renderable)
+  print("\n".join(line.rstrip() for line in captured.get().splitlines()))
+
+
+def print_json(document) -> None:
+  """Prints ``document`` as indented JSON (the ``--json`` of a listing); NaN is refused."""
+  print(json.dumps(document, indent=2, allow_nan=False))

@@ -1,0 +1,48 @@
+"""What ``softbench zoo list`` and ``zoo add`` print: the zoo's files as a table, what was added,
+and how much of its budget the zoo holds."""
+
+import pathlib
+
+from rich.console import Group
+from rich.console import RenderableType
+
+from softbench import terminal
+from softbench import zoo
+
+KIB = 2**10  # (bytes)
+MIB = 2**20  # (bytes)
+
+
+def usage(folder: pathlib.Path, entries: dict[str, zoo.Entry]) -> str:
+  """``1.2 MiB of 100 MiB (FOLDER)``: what ``entries`` (the zoo ``folder``'s) hold of its
+  budget."""
+  return f"{zoo.size_bytes(entries) / MIB:.1f} MiB of {zoo.BUDGET_BYTES / MIB:.0f} MiB ({folder})"
+
+
+def contents(folder: pathlib.Path) -> RenderableType:
+  """The zoo's files (kind, size, records, path), how much they hold, then any problem of a
+  file against the manifest."""
+  entries = zoo.read_manifest(folder)
+  rows = [
+    [entry.kind, f"{entry.bytes / KIB:.1f}", str(len(entry.records)), path]
+    for path, entry in sorted(entries.items())
+  ]
+  return Group(
+    terminal.table(("kind", "KiB", "records", "path"), rows, right=("KiB", "records")),
+    f"{len(entries)} files, {usage(folder, entries)}",
+    *(f"problem: {problem}" for problem in zoo.check_files(folder)),
+  )
+
+
+def additions(added: list[zoo.Entry], skipped: list[pathlib.Path], folder: pathlib.Path) -> str:
+  """What ``zoo.add`` did (its ``added`` entries and ``skipped`` cache files), then how much the
+  zoo ``folder`` holds now; one fact a line."""
+  lines = [
+    f"added {entry.path} ({entry.kind}, {entry.bytes / KIB:.1f} KiB, {len(entry.records)} records)"
+    for entry in added
+  ]
+  lines += [
+    f"skipped {path.name}: its training has not started in the data home" for path in skipped
+  ]
+  lines.append(f"zoo: {usage(folder, zoo.read_manifest(folder))}")
+  return "\n".join(lines)
