@@ -24,14 +24,17 @@ bench: $(STAMP)
 models: $(STAMP)
 	$(VENV)/bin/softbench models export --measure-speed
 
-# Every agent on every task of the leaderboard's robots, then Exp1S on each tendon family, then
-# the pages.
+# Every agent on every task of the leaderboard's robots as one sweep on Ray (softbench sweep; each
+# dataset, forward model and agent built once), then Exp1S on each tendon family, then the pages.
 # PROFILE=paper (default) is the paper's budget: hours per agent on a laptop CPU. A setting that
-# already has a record of this profile in leaderboard/results is skipped, and a run under way
+# already has a record of this profile in leaderboard/results is skipped, and work under way
 # resumes from the cached datasets, checkpoints, training snapshots and finished seeds, so an
 # interrupted fill goes on where it stopped; the pages show the newest record of each setting.
+# ADDRESS=HOST:PORT runs the sweep on that Ray cluster (docs/sweep.md); WORKERS=N: processes per
+# Exp1S run (softbench run --workers; empty: one per core).
 PROFILE ?= paper
-WORKERS ?=# Processes per run (softbench run --workers); empty: one per core.
+ADDRESS ?=
+WORKERS ?=
 RESULTS := leaderboard/results
 # The grid comes from the library (softbench.leaderboard.grid), once softbench is installed.
 LEADERBOARD_ROBOTS = $(shell $(VENV)/bin/softbench leaderboard --grid robots)
@@ -39,13 +42,9 @@ LEADERBOARD_TASKS = $(shell $(VENV)/bin/softbench leaderboard --grid tasks)
 LEADERBOARD_AGENTS = $(shell $(VENV)/bin/softbench leaderboard --grid agents)
 EXP1S_FAMILIES = $(shell $(VENV)/bin/softbench leaderboard --grid families)
 leaderboard: $(STAMP)
-	set -e; for robot in $(LEADERBOARD_ROBOTS); do for task in $(LEADERBOARD_TASKS); do \
-	  for agent in $(LEADERBOARD_AGENTS); do \
-	    if ls $(RESULTS)/$$agent-$$robot-$$task-$(PROFILE)-physics-*.json >/dev/null 2>&1; then \
-	      echo "skipped $$agent on $$robot $$task: it has a $(PROFILE) record"; continue; fi; \
-	    $(VENV)/bin/softbench run --robot $$robot --task $$task --agent $$agent --profile $(PROFILE) \
-	      $(if $(WORKERS),--workers $(WORKERS)) --results $(RESULTS); \
-	  done; done; done
+	$(VENV)/bin/softbench sweep --robots $(LEADERBOARD_ROBOTS) --tasks $(LEADERBOARD_TASKS) \
+	  --agents $(LEADERBOARD_AGENTS) --profile $(PROFILE) $(if $(ADDRESS),--address $(ADDRESS)) \
+	  --results $(RESULTS)
 	set -e; for family in $(EXP1S_FAMILIES); do \
 	  named=$$([ $$family = tendon ] || echo "$$family-"); \
 	  if ls $(RESULTS)/smpl-exp1s-$${named}$(PROFILE)-*.json >/dev/null 2>&1; then \

@@ -23,6 +23,7 @@ from softbench import run as run_module
 from softbench import saving
 from softbench import storage
 from softbench import suite
+from softbench import sweep  # Ray loads only when a sweep runs.
 from softbench import terminal
 from softbench import tuning
 from softbench import zoo
@@ -230,6 +231,20 @@ def _check_record_arguments(args: argparse.Namespace) -> None:
   storage.check_writable(args.results, "result records to", folder=True)
   if args.json:
     storage.check_writable(args.json, "result record")
+
+
+def _sweep(args: argparse.Namespace) -> None:
+  sweep.sweep(
+    args.robots,
+    args.tasks,
+    args.agents,
+    args.results,
+    args.profile,
+    args.seeds,
+    args.eval,
+    args.address,
+    args.data_home,
+  )
 
 
 def _leaderboard(args: argparse.Namespace) -> None:
@@ -448,6 +463,48 @@ def build_parser() -> argparse.ArgumentParser:
     help=_FAULT_HELP + "; the agent is trained on the healthy robot",
   )
   run_parser.set_defaults(run=_run)
+  sweep_parser = commands.add_parser(
+    "sweep",
+    help="run a grid of robots, tasks and agents as Ray tasks, here or on a Ray cluster",
+    description="Runs every setting (robot, task, agent, eval mode) that --results has no "
+    "record of for the profile, as Ray tasks: each babbling dataset, forward model and agent "
+    "is built once and shared, and each record is the one softbench run writes. Without "
+    "--address, on a local Ray with one worker per core; docs/sweep.md for a cluster.",
+  )
+  sweep_parser.add_argument(
+    "--robots", nargs="+", required=True, metavar="ROBOT", help="e.g. tendon-1 tendon-3"
+  )
+  sweep_parser.add_argument(
+    "--tasks", nargs="+", required=True, metavar="TASK", help=f"of {', '.join(suite.TASKS)}"
+  )
+  sweep_parser.add_argument(
+    "--agents", nargs="+", required=True, metavar="AGENT", help=f"of {', '.join(agents.AGENTS)}"
+  )
+  _add_profile_argument(sweep_parser)
+  sweep_parser.add_argument("--seeds", type=int, help="number of seeds (default: the profile's)")
+  sweep_parser.add_argument(
+    "--eval",
+    nargs="+",
+    default=["physics"],
+    metavar="MODE",
+    help="the error fed back: physics (default), model, open-loop; several: a setting each",
+  )
+  sweep_parser.add_argument(
+    "--address",
+    help="HOST:PORT of a Ray cluster's head (ray start --head); default: a local Ray",
+  )
+  sweep_parser.add_argument(
+    "--data-home",
+    help="the data home of this machine and every worker, e.g. on shared storage "
+    "(default: $SOFTBENCH_HOME)",
+  )
+  sweep_parser.add_argument(
+    "--results",
+    default="leaderboard/results",
+    help="folder of the result records (default leaderboard/results)",
+  )
+  sweep_parser.set_defaults(run=_sweep)
+
   board_parser = commands.add_parser(
     "leaderboard",
     help="rank the result records per robot and task",
@@ -613,6 +670,7 @@ def main(argv: list[str] | None = None) -> int:
     video.RenderingFailed,
     continual.ForgettingDetected,
     zoo_verification.ZooMismatch,
+    sweep.SweepFailed,
   ) as error:
     print(f"softbench: error: {dataset.first_line(error)}", file=sys.stderr)
     return EXIT_FAILURE

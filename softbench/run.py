@@ -290,17 +290,50 @@ def score_seed(run: RunSettings, seed: int) -> dict:
   return seed_entry(seed, episode, arm)
 
 
-def _run_seed(seed: int, run: RunSettings, show_progress: bool) -> tuple[dict, episodes.Episode]:
-  """The episode of ``seed`` (``seed_episode``, or the one an interrupted run of the same
-  settings and code saved) and its record entry; a new episode is saved at once."""
+def resumed_seed(run: RunSettings, seed: int) -> tuple[dict, episodes.Episode] | None:
+  """The episode of ``seed`` that an interrupted run of the same settings and code saved, with its
+  record entry; None if there is none."""
   episode = episode_snapshots.load(run, seed)
-  if episode is not None:
-    return seed_entry(seed, episode, robots.make(run.robot).with_faults(run.faults)), episode
+  if episode is None:
+    return None
+  return seed_entry(seed, episode, robots.make(run.robot).with_faults(run.faults)), episode
+
+
+def fresh_seed(
+  run: RunSettings, seed: int, show_progress: bool = False
+) -> tuple[dict, episodes.Episode]:
+  """``seed_episode``'s record entry, checked to be finite (a record must hold it), and the
+  episode."""
   episode, arm = _episode_and_arm(run, seed, show_progress)
   entry = seed_entry(seed, episode, arm)
-  records.check_finite(entry, f"seed {seed}'s scores")  # Kept only if a record can hold it.
-  episode_snapshots.save(run, seed, episode)
+  records.check_finite(entry, f"seed {seed}'s scores")
   return entry, episode
+
+
+def _run_seed(seed: int, run: RunSettings, show_progress: bool) -> tuple[dict, episodes.Episode]:
+  """The record entry and episode of ``seed``: ``resumed_seed``, else ``fresh_seed``, whose
+  episode is saved at once for a later run to resume from."""
+  outcome = resumed_seed(run, seed)
+  if outcome is None:
+    outcome = fresh_seed(run, seed, show_progress)
+    episode_snapshots.save(run, seed, outcome[1])
+  return outcome
+
+
+def take_from_zoo(run: RunSettings) -> tuple[list[str], bool]:
+  """For an agent trained on babbling, the zoo files taken for the checkpoints of ``run``'s seeds
+  that the data home lacks (``zoo.take``), and whether every one is now in the data home; for
+  the other agents nothing, and False."""
+  learner = agents.learner(run.agent)
+  if learner is None:
+    return [], False
+  arm = robots.make(run.robot)
+  return zoo.take(
+    [
+      learned.checkpoint_path(run.agent, arm, seed, run.profile, learner.per_module)
+      for seed in range(run.seeds)
+    ]
+  )
 
 
 def execute(run: RunSettings, show_progress: bool = True, workers: int | None = None) -> dict:
@@ -323,21 +356,9 @@ def execute_episodes(
   them (``episode_snapshots.discard``) once the record is safely written."""
   started = time.perf_counter()
   origin = provenance.provenance(str(learned.training.default_device()))
-  arm = robots.make(run.robot)
-  taken = []
-  learner = agents.learner(run.agent)
-  if learner is not None:
-    taken, trained = zoo.take(
-      [
-        learned.checkpoint_path(run.agent, arm, seed, run.profile, learner.per_module)
-        for seed in range(run.seeds)
-      ]
-    )
-    if not trained:
-      data.collect(
-        run.robot, samples=run.profile.samples, seed=learned.DATA_SEED, progress=show_progress
-      )
-  elif agents.describe(run.agent).learned:  # It learns by acting, on the babbling targets (sac).
+  taken, trained = take_from_zoo(run)
+  learns = agents.learner(run.agent) is not None or agents.describe(run.agent).learned
+  if learns and not trained:  # Some seed trains on babbling (or acts towards its targets, sac).
     data.collect(
       run.robot, samples=run.profile.samples, seed=learned.DATA_SEED, progress=show_progress
     )
@@ -352,15 +373,35 @@ def execute_episodes(
       run.helpers,
       show_progress,
     )
-    results = {"scored_modules": [section["target_module"]], "per_seed": [], "adaptive": section}
+    return assemble_record(run, origin, [], taken, time.perf_counter() - started, section), []
+  if show_progress:
+    episode_snapshots.report_resuming(episode_snapshots.folder(run), run.seeds)
+  outcomes = parallel_seeds.over_seeds(
+    _run_seed, run.seeds, (run,), f"{run.agent} on {run.task}", show_progress, workers
+  )
+  if not keep_seeds:
+    episode_snapshots.discard(run)
+  record = assemble_record(run, origin, outcomes, taken, time.perf_counter() - started)
+  return record, [episode for _, episode in outcomes]
+
+
+def assemble_record(
+  run: RunSettings,
+  origin: dict,
+  outcomes: list[tuple[dict, episodes.Episode]],
+  taken: list[str],
+  wall_time_s: float,
+  adaptive: dict | None = None,
+) -> dict:
+  """The result record of ``run``: its provenance ``origin`` (``records.provenance``) and
+  settings, every seed's entry and the scored modules from ``outcomes`` (seed order), what an
+  agent that learns by acting spent on each seed's training (read from its cache), the zoo files
+  ``taken`` for it and ``wall_time_s``; for an adaptive run its ``adaptive`` section instead of
+  per-seed scores."""
+  arm = robots.make(run.robot)
+  if adaptive is not None:
+    results = {"scored_modules": [adaptive["target_module"]], "per_seed": [], "adaptive": adaptive}
   else:
-    if show_progress:
-      episode_snapshots.report_resuming(episode_snapshots.folder(run), run.seeds)
-    outcomes = parallel_seeds.over_seeds(
-      _run_seed, run.seeds, (run,), f"{run.agent} on {run.task}", show_progress, workers
-    )
-    if not keep_seeds:
-      episode_snapshots.discard(run)
     results = {
       "scored_modules": list(outcomes[0][1].scored_modules),
       "per_seed": [entry for entry, _ in outcomes],
@@ -372,7 +413,7 @@ def execute_episodes(
       results["training"] = {
         "per_seed": [{"seed": seed, **(summary or {})} for seed, summary in enumerate(spent)]
       }
-  record = {
+  return {
     "format": RECORD_FORMAT,
     "version": RECORD_VERSION,
     **origin,
@@ -387,9 +428,8 @@ def execute_episodes(
     "faults": [fault_model.describe(arm, fault) for fault in run.faults],
     **results,
     **zoo.section(taken),
-    "wall_time_s": round(time.perf_counter() - started, 3),
+    "wall_time_s": round(wall_time_s, 3),
   }
-  return record, [] if run.adaptive else [episode for _, episode in outcomes]
 
 
 def summary(record: dict, metric: str) -> tuple[list[metrics.Statistic], metrics.Statistic]:

@@ -1,4 +1,5 @@
-"""``make leaderboard``: every setting once, skipping those that already have a record."""
+"""``make leaderboard``: one sweep over the grid (the sweep skips the settings that have a record:
+test_sweep), then Exp1S per tendon family unless it has a record, then the pages."""
 
 import os
 import pathlib
@@ -62,34 +63,40 @@ def _fill(checkout: pathlib.Path) -> list[str]:
   return (checkout / ".venv" / "bin" / "calls.txt").read_text().splitlines()
 
 
-def test_the_fill_runs_every_agent_on_every_task_then_exp1s_then_the_pages(checkout):
+def test_the_fill_sweeps_every_agent_on_every_task_then_exp1s_then_the_pages(checkout):
   calls = _fill(checkout)
   axes = grid.lists()
   assert set(axes["agents"]) == set(agents.AGENTS)
-  runs = [call for call in calls if "--task" in call]
-  assert len(runs) == len(axes["robots"]) * len(axes["tasks"]) * len(agents.AGENTS)
-  assert {call.split("--robot ")[1].split()[0] for call in runs} == set(axes["robots"])
-  assert all("--profile paper" in call for call in runs)
+  (sweep,) = [call for call in calls if call.startswith("sweep")]
+  assert sweep == (
+    f"sweep --robots {' '.join(axes['robots'])} --tasks {' '.join(axes['tasks'])} "
+    f"--agents {' '.join(axes['agents'])} --profile paper --results leaderboard/results"
+  )
   exp1s = [call for call in calls if "--protocol exp1s" in call]
   assert exp1s == [
     f"run --protocol exp1s --family {family} --agent smpl --profile paper "
     f"--results leaderboard/results"
     for family in robots.TENDON_FAMILIES
   ]
-  assert calls[-len(exp1s) - 1 : -1] == exp1s  # After every task's runs.
-  assert calls[-1] == "leaderboard --results leaderboard/results --write"
+  assert calls == [sweep, *exp1s, "leaderboard --results leaderboard/results --write"]
 
 
-def test_an_interrupted_fill_skips_the_settings_that_have_records(checkout):
+def test_the_fill_sweeps_on_a_cluster_when_given_its_address(checkout):
+  subprocess.run(
+    ["make", "--no-print-directory", "leaderboard", "ADDRESS=10.0.0.1:6379"],
+    cwd=checkout,
+    check=True,
+    capture_output=True,
+    timeout=60,
+  )
+  calls = (checkout / ".venv" / "bin" / "calls.txt").read_text().splitlines()
+  assert "--address 10.0.0.1:6379" in calls[0] and calls[0].startswith("sweep")
+
+
+def test_an_interrupted_fill_skips_the_exp1s_families_that_have_records(checkout):
   results = checkout / "leaderboard" / "results"
-  (results / "smpl-tendon-3-spiral-paper-physics-2026-11-24T000000Z.json").touch()
-  # Another profile's record does not count.
-  (results / "lstm-tendon-3-spiral-default-physics-2026-11-24T000000Z.json").touch()
   (results / "smpl-exp1s-paper-2026-11-24T000000Z.json").touch()
   calls = _fill(checkout)
-  assert not any("--robot tendon-3 --task spiral --agent smpl " in call for call in calls)
-  assert sum("--robot tendon-3 --task spiral --agent lstm " in call for call in calls) == 1
-  assert sum("--robot tendon-local-3 --task spiral --agent smpl " in call for call in calls) == 1
   # The tendon family's Exp1S record does not stand for the tendon-local family's.
   assert [call for call in calls if "exp1s" in call] == [
     "run --protocol exp1s --family tendon-local --agent smpl --profile paper "

@@ -1,0 +1,136 @@
+"""A sweep's plan run as Ray tasks, and its records written as their settings complete.
+
+Each build and each evaluation is one Ray task of one core (a babbling collection: up to
+``cluster.COLLECTION_CORES``), given the results of the builds it needs, so Ray runs the graph in
+its order and in parallel; a build the data home holds is shipped instead (``shipping``). A task
+whose worker dies is run again (``cluster.MAX_RETRIES``). Each finished episode is kept at once
+(``episode_snapshots``), so an interrupted sweep resumes; once a setting's seeds are all in, its
+record (``run.assemble_record``, as ``softbench run`` makes it) is saved (``saving.save``) and
+its kept episodes go. A task's error is not retried: the settings that need it fail, and the
+others go on.
+
+A record's wall time is the sweep's, from its start to that record; its provenance is the
+driver's, taken at the start, with the device the workers trained on.
+"""
+
+import pathlib
+import time
+
+import ray
+
+from smpl.files import first_line
+from softbench import episode_snapshots
+from softbench import run as run_module
+from softbench import saving
+from softbench.records import provenance
+from softbench.sweep import cluster
+from softbench.sweep import display
+from softbench.sweep import grid
+from softbench.sweep import shipping
+from softbench.sweep import tasks
+
+_POLL_SECONDS = 0.5  # (s) How often the display is refreshed while no task finishes.
+_BUILD = ray.remote(tasks.build)
+_EVALUATE = ray.remote(tasks.evaluate)
+
+
+def _failure(error: ray.exceptions.RayError) -> str:
+  """A task's error on one line: the exception the task raised, or what befell its worker."""
+  cause = error.cause if isinstance(error, ray.exceptions.RayTaskError) else error
+  return f"{type(cause).__name__}: {first_line(cause)}"
+
+
+def _submit(plan: grid.Plan) -> dict[ray.ObjectRef, grid.Build | grid.Evaluation]:
+  """Submits every task of ``plan``, each given the refs of the builds it needs (a shipped one's
+  put in the object store); the work of each task's ref, builds first."""
+  environment = cluster.runtime_env()
+  refs, work = {}, {}
+  for build in plan.builds:
+    if build in plan.found:
+      refs[build] = ray.put(shipping.read(build.files))
+      continue
+    cores = cluster.collection_cores() if build.kind == "dataset" else 1
+    refs[build] = _BUILD.options(
+      name=build.label,
+      num_cpus=cores,
+      max_retries=cluster.MAX_RETRIES,
+      runtime_env=environment,
+    ).remote(build.kind, build.arguments, build.files, *(refs[need] for need in build.needs))
+    work[refs[build]] = build
+  for evaluation in plan.evaluations:
+    needed = () if evaluation.agent is None else (refs[evaluation.agent],)
+    ref = _EVALUATE.options(
+      name=evaluation.label,
+      num_cpus=1,
+      max_retries=cluster.MAX_RETRIES,
+      runtime_env=environment,
+    ).remote(evaluation.run, evaluation.seed, *needed)
+    work[ref] = evaluation
+  return work
+
+
+def execute(
+  plan: grid.Plan, results: pathlib.Path, show_progress: bool
+) -> tuple[list[pathlib.Path], dict[str, str]]:
+  """Runs ``plan`` on the Ray this process is connected to; the records written in
+  ``results`` (in the order they were) and the settings that failed (by ``grid.setting_name``)
+  with the error that failed them, on one line.
+
+  Raises:
+    ValueError: a node runs other source than this machine (one line).
+    KeyboardInterrupt: Ctrl-C; the outstanding tasks are cancelled first.
+  """
+  started = time.perf_counter()
+  origin = provenance.provenance(cluster.check_nodes())
+  outcomes = {run: {} for run in plan.settings}
+  for (run, seed), outcome in plan.resumed.items():
+    outcomes[run][seed] = outcome
+  written, failures = [], {}
+
+  def complete(run: run_module.RunSettings) -> None:
+    if len(outcomes[run]) < run.seeds or run in failures:
+      return
+    in_order = [outcomes[run][seed] for seed in range(run.seeds)]
+    wall_time_s = time.perf_counter() - started
+    record = run_module.assemble_record(run, origin, in_order, plan.taken[run], wall_time_s)
+    written.append(saving.save(run_module, record, results, None)[0])
+    episode_snapshots.discard(run)
+
+  work = _submit(plan)
+  pending, finished, failed = list(work), set(plan.found), 0
+  cores = cluster.cores()
+  try:
+    with display.Display(len(work), len(plan.settings), show_progress) as shown:
+      for run in plan.settings:  # Those whose every seed was kept.
+        complete(run)
+      while pending:
+        ready, pending = ray.wait(pending, num_returns=len(pending), timeout=_POLL_SECONDS)
+        for ref in ready:  # In submission order: a build before the evaluations it feeds.
+          task = work[ref]
+          finished.add(task)
+          try:
+            value = ray.get(ref)
+          except ray.exceptions.RayError as error:
+            failed += 1
+            if isinstance(task, grid.Evaluation):
+              failures.setdefault(task.run, _failure(error))
+            continue
+          if isinstance(task, grid.Build):
+            shipping.write_missing(value)
+          else:
+            episode_snapshots.save(task.run, task.seed, value[1])
+            outcomes[task.run][task.seed] = value
+            complete(task.run)
+        running = sum(all(need in finished for need in _needs(work[ref])) for ref in pending)
+        shown.update(len(finished) - len(plan.found), min(running, cores), failed, len(written))
+  except BaseException:  # Ctrl-C, or a record that cannot be written: nothing more runs.
+    for ref in pending:
+      ray.cancel(ref, force=True)
+    raise
+  return written, {grid.setting_name(run): message for run, message in failures.items()}
+
+
+def _needs(task: grid.Build | grid.Evaluation) -> tuple[grid.Build, ...]:
+  if isinstance(task, grid.Build):
+    return task.needs
+  return () if task.agent is None else (task.agent,)

@@ -1,0 +1,254 @@
+"""A sweep's grid and the graph of work behind it, planned in the driver before Ray starts.
+
+Every setting of the grid (robot x task x agent x eval mode, one profile and seed count) is a
+``run.RunSettings``; one that already has a record of its profile in the results folder is
+skipped, as ``make leaderboard`` skips it. Each seed of the others is an ``Evaluation``, unless
+an interrupted run or sweep kept its episode (``episode_snapshots``). An evaluation of a learned
+agent needs the ``Build`` of that agent for its robot, seed and profile, shared by every task and
+eval mode; an agent trained on babbling needs the forward model of each view it reads (shared by
+the agents that read that view: the baselines share the whole arm's) and the robot's babbling
+dataset, which sac trains on too. A build whose cache files the data home holds already is not
+built again: its files are shipped from here.
+"""
+
+import dataclasses
+import importlib
+import itertools
+import pathlib
+
+from softbench import agents
+from softbench import episodes
+from softbench import profiles
+from softbench import robots
+from softbench import run as run_module
+from softbench import storage
+from softbench.agents import forward_models
+from softbench.agents import learned
+from softbench.agents import learners
+from softbench.data import dataset as babbling_dataset
+
+KINDS = ("dataset", "forward", "agent")  # What a build makes, in the order they depend.
+
+
+@dataclasses.dataclass(frozen=True)
+class Grid:
+  """The settings a sweep covers; ``seeds`` None takes the profile's."""
+
+  robots: tuple[str, ...]
+  tasks: tuple[str, ...]
+  agents: tuple[str, ...]
+  profile: str = profiles.DEFAULT_PROFILE
+  seeds: int | None = None
+  eval_modes: tuple[str, ...] = ("physics",)
+
+  def settings(self) -> list[run_module.RunSettings]:
+    """Every setting once, checked (``run.settings``), robot by robot, then task, agent, eval
+    mode.
+
+    Raises:
+      ValueError: an empty list, or a setting ``run.settings`` refuses (one line).
+    """
+    for name, values in (
+      ("robots", self.robots),
+      ("tasks", self.tasks),
+      ("agents", self.agents),
+      ("eval modes", self.eval_modes),
+    ):
+      if not values:
+        raise ValueError(f"a sweep needs at least one of its {name}")
+    every = [
+      run_module.settings(task, agent, robot, self.seeds, self.profile, eval_mode)
+      for robot, task, agent, eval_mode in itertools.product(
+        self.robots, self.tasks, self.agents, self.eval_modes
+      )
+    ]
+    return list(dict.fromkeys(every))  # A name given twice is one setting.
+
+
+@dataclasses.dataclass(frozen=True)
+class Build:
+  """One thing a sweep builds once and shares: a babbling dataset, a forward model or an agent.
+
+  ``arguments`` go to its builder (``tasks.BUILDERS[kind]``); ``files`` are its cache files,
+  relative to the data home, in the order they are written (a reader's first look last);
+  ``needs`` are the builds it is made from."""
+
+  kind: str
+  label: str
+  arguments: tuple
+  files: tuple[str, ...]
+  needs: tuple["Build", ...] = ()
+
+
+@dataclasses.dataclass(frozen=True)
+class Evaluation:
+  """One seed's episode of a setting, by the agent that ``agent`` builds (None: built on the
+  spot, as an agent that does not learn is)."""
+
+  run: run_module.RunSettings
+  seed: int
+  agent: Build | None
+
+  @property
+  def label(self) -> str:
+    return f"evaluate {setting_name(self.run)} seed {self.seed}"
+
+
+@dataclasses.dataclass(frozen=True)
+class Plan:
+  """What a sweep does: the settings to complete (grid order), the records it skips, the seeds
+  resumed from kept episodes, the evaluations to run and the builds they need (each after those
+  it needs), those of them the data home holds (shipped, not built), and the zoo files taken for
+  each setting's checkpoints (``run.take_from_zoo``)."""
+
+  settings: tuple[run_module.RunSettings, ...]
+  skipped: tuple[pathlib.Path, ...]
+  resumed: dict[tuple[run_module.RunSettings, int], tuple[dict, episodes.Episode]]
+  evaluations: tuple[Evaluation, ...]
+  builds: tuple[Build, ...]
+  found: frozenset[Build]
+  taken: dict[run_module.RunSettings, list[str]]
+
+
+def setting_name(run: run_module.RunSettings) -> str:
+  """``agent-robot-task-profile-eval``, as its record's file name begins."""
+  return f"{run.agent}-{run.robot}-{run.task}-{run.profile.name}-{run.eval_mode}"
+
+
+def existing_record(run: run_module.RunSettings, results: pathlib.Path) -> pathlib.Path | None:
+  """A record of ``run``'s setting in ``results`` (any date), named as ``run.record_path`` names
+  it; None if there is none."""
+  pattern = run_module.record_path(
+    {
+      "agent": run.agent,
+      "robot": run.robot,
+      "task": run.task,
+      "profile": run.profile.name,
+      "eval_mode": run.eval_mode,
+      "faults": [],
+      "date": "*",  # Any date stamp.
+    },
+    results,
+  )
+  return next(iter(sorted(results.glob(pattern.name))), None)
+
+
+def _relative(path: pathlib.Path) -> str:
+  return path.relative_to(storage.softbench_home()).as_posix()
+
+
+def _dataset_build(robot: str, profile: profiles.Profile) -> Build:
+  config = babbling_dataset.generating_config(robot, profile.samples, learned.DATA_SEED)
+  folder = babbling_dataset.dataset_folder(config)
+  return Build(
+    "dataset",
+    f"babbling {robot} {profile.samples} samples",
+    (robot, profile.samples),
+    tuple(  # The manifest last: a reader takes a dataset by its manifest.
+      _relative(folder / name) for name in (babbling_dataset.NPZ_NAME, babbling_dataset.JSON_NAME)
+    ),
+  )
+
+
+def _forward_builds(
+  robot: str, per_module: bool, seed: int, profile: profiles.Profile
+) -> tuple[Build, ...]:
+  """The forward model of each view an agent reads, each a build of its own."""
+  arm = robots.make(robot)
+  views = learners.views(arm, per_module)
+  configs = forward_models.configs(
+    arm,
+    views,
+    profile.samples,
+    learned.DATA_SEED,
+    learned.forward_config(seed, profile),
+    learned.TRAINING_VERSION,
+  )
+  return tuple(
+    Build(
+      "forward",
+      f"forward {robot} {view.name} seed {seed}",
+      (robot, per_module, index, seed, profile),
+      (_relative(forward_models.cache_file(config)),),
+      (_dataset_build(robot, profile),),
+    )
+    for index, (view, config) in enumerate(zip(views, configs))
+  )
+
+
+def agent_build(agent: str, robot: str, seed: int, profile: profiles.Profile) -> Build | None:
+  """The build of a learned agent (None for one that does not learn): one trained on babbling
+  needs its dataset and forward models, one that learns by acting (sac) the dataset, whose
+  targets it trains on. Its files are its checkpoint, where its module says
+  (``checkpoint_path``)."""
+  entry = agents.describe(agent)
+  arm = robots.make(robot)
+  dataset = _dataset_build(robot, profile)
+  if entry.learner is not None:
+    checkpoint = learned.checkpoint_path(agent, arm, seed, profile, entry.learner.per_module)
+    needs = (dataset, *_forward_builds(robot, entry.learner.per_module, seed, profile))
+  elif entry.learned:
+    path = getattr(importlib.import_module(entry.module), "checkpoint_path", None)
+    checkpoint, needs = (None if path is None else path(arm, seed, profile)), (dataset,)
+  else:
+    return None
+  files = () if checkpoint is None else (_relative(checkpoint),)
+  return Build(
+    "agent", f"agent {agent} {robot} seed {seed}", (agent, robot, seed, profile), files, needs
+  )
+
+
+def is_found(build: Build) -> bool:
+  """Whether the data home holds every cache file of ``build`` (one that names none: never)."""
+  home = storage.softbench_home()
+  return bool(build.files) and all((home / name).is_file() for name in build.files)
+
+
+def plan(grid: Grid, results: pathlib.Path) -> Plan:
+  """The work of ``grid`` with the records in ``results`` and the data home as they are.
+
+  Raises:
+    ValueError: a setting ``Grid.settings`` refuses (one line).
+  """
+  pending, skipped, resumed, evaluations, taken_by_agent = [], [], {}, [], {}
+  for run in grid.settings():
+    existing = existing_record(run, results)
+    if existing is not None:
+      skipped.append(existing)
+      continue
+    pending.append(run)
+    agent_key = (run.agent, run.robot, run.profile, run.seeds)
+    if agent_key not in taken_by_agent:  # Before the checkpoints are looked for.
+      taken_by_agent[agent_key] = run_module.take_from_zoo(run)[0]
+    for seed in range(run.seeds):
+      outcome = run_module.resumed_seed(run, seed)
+      if outcome is not None:
+        resumed[run, seed] = outcome
+      else:
+        evaluations.append(
+          Evaluation(run, seed, agent_build(run.agent, run.robot, seed, run.profile))
+        )
+  builds, found = {}, set()
+
+  def add(build: Build) -> None:
+    if build in builds:
+      return
+    if is_found(build):
+      found.add(build)
+    else:
+      for need in build.needs:
+        add(need)
+    builds[build] = None
+
+  for evaluation in evaluations:
+    if evaluation.agent is not None:
+      add(evaluation.agent)
+  return Plan(
+    tuple(pending),
+    tuple(skipped),
+    resumed,
+    tuple(evaluations),
+    tuple(builds),
+    frozenset(found),
+    {run: taken_by_agent[run.agent, run.robot, run.profile, run.seeds] for run in pending},
+  )

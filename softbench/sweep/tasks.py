@@ -1,0 +1,66 @@
+"""What a sweep's Ray tasks run in their worker processes: builds, evaluations and a node's facts.
+
+Each task first sets its process up as ``softbench run``'s seed workers are (one torch thread,
+``smpl.training.CPU_THREADS``; one-line warnings) and writes the cache files of the builds it is
+given that its data home lacks (``shipping``). A build then finds or makes its cached files and
+returns them; an evaluation returns its seed's record entry and episode (``run.fresh_seed``).
+"""
+
+import ray
+import torch
+
+from smpl import training
+from softbench import agents
+from softbench import data
+from softbench import episode_snapshots
+from softbench import parallel_seeds
+from softbench import robots
+from softbench import run as run_module
+from softbench.agents import learned
+from softbench.agents import learners
+from softbench.sweep import shipping
+
+
+def _set_up() -> None:
+  """As ``parallel_seeds._init_worker``, except Ctrl-C, which the driver handles by cancelling."""
+  torch.set_num_threads(training.CPU_THREADS)
+  parallel_seeds.one_line_warnings()
+
+
+def _collect(robot: str, samples: int) -> None:
+  """The babbling dataset, simulated on as many threads as the task has cores."""
+  cores = int(ray.get_runtime_context().get_assigned_resources().get("CPU", 1))
+  data.collect(robot, samples=samples, seed=learned.DATA_SEED, workers=cores, progress=False)
+
+
+def _train_forward_model(robot: str, per_module: bool, view: int, seed: int, profile) -> None:
+  """The forward model of view ``view`` of the agents with ``per_module`` (``learners.views``)."""
+  arm = robots.make(robot)
+  learned.trained_forward_models(arm, [learners.views(arm, per_module)[view]], seed, profile)
+
+
+def _build_agent(agent: str, robot: str, seed: int, profile) -> None:
+  agents.make(agent, robot, seed, profile)
+
+
+BUILDERS = {"dataset": _collect, "forward": _train_forward_model, "agent": _build_agent}
+
+
+def build(kind: str, arguments: tuple, files: tuple[str, ...], *needed: shipping.Files):
+  """Builds (or finds) a ``grid.Build`` of ``kind`` from the builds it needs; its cache files."""
+  _set_up()
+  shipping.write_missing(*needed)
+  BUILDERS[kind](*arguments)
+  return shipping.read(files)
+
+
+def evaluate(run: run_module.RunSettings, seed: int, *needed: shipping.Files):
+  """Seed ``seed``'s record entry and episode of ``run``, by the agent of ``needed`` if any."""
+  _set_up()
+  shipping.write_missing(*needed)
+  return run_module.fresh_seed(run, seed)
+
+
+def node_facts() -> tuple[str, str]:
+  """The hash of this node's softbench and smpl source, and the device its agents train on."""
+  return episode_snapshots.source_sha256(), str(training.default_device())

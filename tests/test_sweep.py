@@ -1,0 +1,220 @@
+"""``softbench sweep`` on a Ray cluster of two nodes on this machine (a head and one more, one core
+each): its records equal ``softbench run``'s, a worker killed mid-task is retried to the same
+records, settings with a record are skipped, an interrupted sweep resumes; bad settings and an
+address where no cluster answers are refused in one line before Ray starts."""
+
+import contextlib
+import dataclasses
+import faulthandler
+import json
+import os
+import pathlib
+import signal
+import threading
+import time
+
+import pytest
+import ray
+from ray import cluster_utils
+
+from softbench import records
+from softbench import run
+from softbench import storage
+from softbench import sweep
+from softbench import zoo
+from softbench.sweep import display
+from softbench.sweep import grid as sweep_grid
+
+GRID = sweep.Grid(("tendon-1",), ("circle", "reach"), ("mlp", "zero"), "tiny", 2)
+VARYING = ("date", "machine", "git_commit", "wall_time_s", records.INTEGRITY_FIELD)  # May differ.
+TEST_SECONDS = 150  # (s) Longest a test may take, on a machine busy with other work.
+HARD_LIMIT_S = 30  # (s) Then, how long a test stuck in Ray's C++ code has before the process ends.
+POLL_SECONDS = 0.02  # (s) How often the killer looks for the worker it kills.
+
+
+@pytest.fixture(scope="module")
+def address():
+  """A Ray cluster on this machine, a head and one more node of one core each; its address.
+
+  (Not on 127.0.0.1: ray.init rewrites a loopback address to the machine's own, where a head
+  bound to the loopback interface does not answer.)"""
+  cluster = cluster_utils.Cluster(
+    initialize_head=True, head_node_args={"num_cpus": 1, "include_dashboard": False}
+  )
+  cluster.add_node(num_cpus=1)
+  yield cluster.address
+  cluster.shutdown()
+
+
+@pytest.fixture(scope="module")
+def expected(tmp_path_factory) -> dict[str, dict]:
+  """``softbench run``'s record of every setting of GRID, by name, as its file holds it (run in a
+  data home of its own)."""
+  with pytest.MonkeyPatch.context() as patch:
+    patch.setenv(storage.HOME_VARIABLE, str(tmp_path_factory.mktemp("run-home")))
+    patch.setenv(zoo.VARIABLE, zoo.OFF)
+    return {
+      sweep_grid.setting_name(settings): json.loads(
+        records.dumps(records.seal(run.execute(settings, show_progress=False, workers=1)))
+      )
+      for settings in GRID.settings()
+    }
+
+
+@pytest.fixture(autouse=True)
+def bounded():
+  """Fails a test that runs over TEST_SECONDS (raised in the main thread, as Ctrl-C would be),
+  and ends the test process if it is stuck in Ray's own code HARD_LIMIT_S later."""
+
+  def over(signal_number, frame):
+    raise TimeoutError(f"the test ran over {TEST_SECONDS} s")
+
+  previous = signal.signal(signal.SIGALRM, over)
+  signal.alarm(TEST_SECONDS)
+  faulthandler.dump_traceback_later(TEST_SECONDS + HARD_LIMIT_S, exit=True)
+  yield
+  faulthandler.cancel_dump_traceback_later()
+  signal.alarm(0)
+  signal.signal(signal.SIGALRM, previous)
+
+
+@pytest.fixture(autouse=True)
+def data_home(tmp_path, monkeypatch) -> pathlib.Path:
+  monkeypatch.setenv(storage.HOME_VARIABLE, str(tmp_path / "home"))
+  return tmp_path / "home"
+
+
+def run_sweep(grid: sweep.Grid, results: pathlib.Path, address: str) -> sweep.SweepResult:
+  return sweep.sweep(
+    grid.robots,
+    grid.tasks,
+    grid.agents,
+    results,
+    grid.profile,
+    grid.seeds,
+    grid.eval_modes,
+    address,
+    show_progress=False,
+  )
+
+
+def name_of(record: dict) -> str:
+  """The record's setting, as ``grid.setting_name`` names it."""
+  return "-".join(record[field] for field in ("agent", "robot", "task", "profile", "eval_mode"))
+
+
+def names_of(paths) -> set[str]:
+  return {name_of(json.loads(path.read_text())) for path in paths}
+
+
+def assert_records_as_run(results: pathlib.Path, grid: sweep.Grid, expected: dict) -> None:
+  """``results`` holds one record of each setting of ``grid``, equal to ``softbench run``'s but
+  for ``VARYING``."""
+  written = [records.read(path) for path in results.glob("*.json")]
+  assert sorted(map(name_of, written)) == sorted(map(sweep_grid.setting_name, grid.settings()))
+  for record in written:
+    assert {key: value for key, value in record.items() if key not in VARYING} == {
+      key: value for key, value in expected[name_of(record)].items() if key not in VARYING
+    }, name_of(record)
+
+
+def test_a_sweep_writes_the_records_softbench_run_writes(address, expected, tmp_path):
+  outcome = run_sweep(GRID, tmp_path / "results", address)
+  assert len(outcome.written) == 4 and outcome.skipped == ()
+  assert_records_as_run(tmp_path / "results", GRID, expected)
+  assert not ray.is_initialized()  # The sweep left the cluster.
+  assert not list(storage.softbench_home().glob("runs/*"))  # No kept episodes: records are in.
+
+
+@contextlib.contextmanager
+def killing_the_first(title: str):
+  """Within the block, the first process whose title begins with ``title`` (a Ray worker
+  running the task of that name) is killed with SIGKILL; yields the killed processes' ids."""
+  killed, stop = [], threading.Event()
+
+  def kill() -> None:
+    while not stop.is_set():
+      for cmdline in pathlib.Path("/proc").glob("[0-9]*/cmdline"):
+        with contextlib.suppress(OSError):
+          if cmdline.read_bytes().startswith(title.encode()):
+            os.kill(int(cmdline.parent.name), signal.SIGKILL)
+            killed.append(int(cmdline.parent.name))
+            return
+      time.sleep(POLL_SECONDS)
+
+  killer = threading.Thread(target=kill, daemon=True)
+  killer.start()
+  try:
+    yield killed
+  finally:
+    stop.set()
+    killer.join()
+
+
+def test_a_worker_killed_mid_task_is_retried_to_the_same_records(address, expected, tmp_path):
+  one_agent = dataclasses.replace(GRID, tasks=("circle",), agents=("mlp",))
+  with killing_the_first("ray::agent mlp tendon-1 seed 1") as killed:
+    run_sweep(one_agent, tmp_path / "results", address)
+  assert len(killed) == 1
+  assert_records_as_run(tmp_path / "results", one_agent, expected)
+
+
+def test_settings_with_a_record_are_skipped(address, expected, tmp_path):
+  results, left_out, recorded = tmp_path / "results", "zero-tendon-1-reach-tiny-physics", []
+  for name, record in expected.items():
+    if name != left_out:
+      recorded.append(run.record_path(record, results))
+      records.write(record, recorded[-1])
+  outcome = run_sweep(GRID, results, address)
+  assert sorted(outcome.skipped) == sorted(recorded)
+  assert names_of(outcome.written) == {left_out}
+  assert run_sweep(GRID, results, address).written == ()  # Nothing left: Ray is not started.
+
+
+def test_an_interrupted_sweep_resumes(address, expected, tmp_path, monkeypatch):
+  results, settings = tmp_path / "results", len(GRID.settings())
+  update = display.Display.update
+
+  def interrupted_after_the_first_record(shown, done, running, failed, written):
+    update(shown, done, running, failed, written)
+    if 1 <= written < settings:
+      raise KeyboardInterrupt
+
+  with monkeypatch.context() as patch:
+    patch.setattr(display.Display, "update", interrupted_after_the_first_record)
+    with pytest.raises(KeyboardInterrupt):
+      run_sweep(GRID, results, address)
+  assert not ray.is_initialized()
+  first = sorted(results.glob("*.json"))
+  assert 1 <= len(first) < settings
+  resumed = run_sweep(GRID, results, address)
+  assert sorted(resumed.skipped) == first
+  assert len(resumed.written) == settings - len(first)
+  assert_records_as_run(results, GRID, expected)
+
+
+@pytest.mark.parametrize(
+  "change,message",
+  [
+    ({"tasks": ("juggle",)}, "unknown task"),
+    ({"agents": ("oracle",)}, "unknown agent"),
+    ({"robots": ("tendon-0",)}, "1 to 10 modules"),
+    ({"profile": "huge"}, "unknown profile"),
+    ({"eval_modes": ("dream",)}, "unknown eval mode"),
+    ({"seeds": 0}, "seeds must be"),
+    ({"agents": ()}, "at least one of its agents"),
+  ],
+)
+def test_bad_settings_are_one_line_before_ray_starts(change, message, tmp_path):
+  with pytest.raises(ValueError, match=message) as raised:
+    run_sweep(dataclasses.replace(GRID, **change), tmp_path / "results", None)
+  assert "\n" not in str(raised.value) and not ray.is_initialized()
+
+
+def test_an_address_where_no_cluster_answers_is_one_line(tmp_path):
+  zero = dataclasses.replace(GRID, agents=("zero",))
+  with pytest.raises(ValueError, match="no Ray cluster answers at 127.0.0.1:1 "):
+    run_sweep(zero, tmp_path / "results", "127.0.0.1:1")
+  with pytest.raises(ValueError, match="HOST:PORT"):
+    run_sweep(zero, tmp_path / "results", "head-without-port")
+  assert not ray.is_initialized()
