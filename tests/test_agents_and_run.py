@@ -56,12 +56,13 @@ class TestEveryAgent:
 
 
 @pytest.mark.parametrize("agent_name", LEARNED_AGENTS)
-def test_training_from_scratch_is_deterministic(agent_name, tmp_path, monkeypatch):
-  """Two data homes, so that nothing is cached: the same seed trains to the same actions, and
+def test_training_from_scratch_is_deterministic(agent_name, tmp_path, babbled_home):
+  """Two data homes, so that no model is cached (the babbling dataset is, copied: its
+  collection's determinism is test_data's): the same seed trains to the same actions, and
   another seed to other actions."""
 
   def actions(home, seed):
-    monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / home))
+    babbled_home(tmp_path / home)
     return episode(agent_name, "tendon-2", "circle", seed).actions
 
   first = actions("first", 1)
@@ -71,9 +72,9 @@ def test_training_from_scratch_is_deterministic(agent_name, tmp_path, monkeypatc
 
 @pytest.mark.parametrize("agent_name", LEARNED_AGENTS)
 def test_checkpoint_round_trip_gives_identical_actions(
-  agent_name, tmp_path, monkeypatch, assert_one_line_retraining
+  agent_name, tmp_path, babbled_home, assert_one_line_retraining
 ):
-  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
+  babbled_home(tmp_path)
   trained = episode(agent_name, "tendon-2", "circle")  # Trains, then saves the checkpoint.
   (checkpoint,) = (tmp_path / learned.CHECKPOINT_FOLDER).glob(f"{agent_name}-*.pt")
   loaded = episode(agent_name, "tendon-2", "circle")
@@ -94,9 +95,9 @@ def test_checkpoint_round_trip_gives_identical_actions(
 
 @pytest.mark.parametrize("damage", ["hello", "flipped weight"])
 def test_a_damaged_cached_forward_model_is_trained_again(
-  damage, tmp_path, monkeypatch, assert_one_line_retraining
+  damage, tmp_path, babbled_home, assert_one_line_retraining
 ):
-  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
+  babbled_home(tmp_path)
   agents.make("mlp", "tendon-2", 0, "tiny")
   (forward,) = (tmp_path / forward_models.FOLDER).glob("*.pt")
   (checkpoint,) = (tmp_path / learned.CHECKPOINT_FOLDER).glob("mlp-*.pt")
@@ -122,11 +123,11 @@ def test_a_damaged_cached_forward_model_is_trained_again(
 
 
 def test_a_folder_at_a_checkpoint_path_is_damage_reported_and_replaced(
-  tmp_path, monkeypatch, assert_one_line_retraining
+  tmp_path, babbled_home, assert_one_line_retraining
 ):
   # The cache owns its paths: whatever stands where its file belongs is damage (one rule,
   # storage.read_cached), reported in one line and replaced by the trained checkpoint.
-  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
+  babbled_home(tmp_path)
   path = learned.checkpoint_path("mlp", robots.make("tendon-2"), 0, profiles.get("tiny"), False)
   (path / "stray.txt").parent.mkdir(parents=True)
   (path / "stray.txt").write_text("not a checkpoint")
@@ -138,9 +139,9 @@ def test_a_folder_at_a_checkpoint_path_is_damage_reported_and_replaced(
 
 @pytest.mark.parametrize("agent_name", agents.babbling_learners())  # sac: in test_sac.
 def test_interrupted_training_resumes_to_the_same_checkpoint(
-  agent_name, interrupted_training, tmp_path, monkeypatch
+  agent_name, interrupted_training, tmp_path, babbled_home
 ):
-  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
+  babbled_home(tmp_path)
   agents.make(agent_name, "tendon-2", 0, "tiny")
   (checkpoint,) = (tmp_path / learned.CHECKPOINT_FOLDER).glob(f"{agent_name}-*.pt")
   uninterrupted = torch.load(checkpoint, weights_only=False)["state_dict"]
@@ -158,7 +159,7 @@ def test_interrupted_training_resumes_to_the_same_checkpoint(
   assert not list(tmp_path.rglob("*.partial"))
 
 
-def test_agents_reading_the_same_view_share_one_forward_model(tmp_path, monkeypatch):
+def test_agents_reading_the_same_view_share_one_forward_model(tmp_path, monkeypatch, babbled_home):
   trained_views, prepare_column = [], protocols.prepare_column
 
   def counted(robot, view, *args):
@@ -168,7 +169,7 @@ def test_agents_reading_the_same_view_share_one_forward_model(tmp_path, monkeypa
   monkeypatch.setattr(protocols, "prepare_column", counted)
 
   def lstm_weights(home, agent_names):
-    monkeypatch.setenv("SOFTBENCH_HOME", str(home))
+    babbled_home(home)
     for name in agent_names:
       agents.make(name, "tendon-2", 0, "tiny")
     (path,) = (home / learned.CHECKPOINT_FOLDER).glob("lstm-*.pt")

@@ -4,6 +4,7 @@ carried to another data home, and records re-scored from it (``softbench zoo``).
 import json
 import shutil
 
+import conftest
 import numpy as np
 import pytest
 
@@ -17,6 +18,7 @@ from softbench import records
 from softbench import suite
 from softbench import zoo
 from softbench.agents import learned
+from softbench.data import dataset as data_files
 from softbench.leaderboard import zoo_catalogue as catalogue
 
 LEARNED_AGENTS = agents.babbling_learners()  # The agents whose weights the zoo keeps.
@@ -31,9 +33,20 @@ def actions(agent_name, seed=0):
   ).actions
 
 
-def use(monkeypatch, home, zoo_folder=None):
+def use(monkeypatch, home, zoo_folder=None, datasets=None):
+  """Makes ``home`` the data home (with a copy of the ``datasets`` folder, if given) and
+  ``zoo_folder`` the zoo (None: turned off)."""
   monkeypatch.setenv("SOFTBENCH_HOME", str(home))
   monkeypatch.setenv(zoo.VARIABLE, str(zoo_folder) if zoo_folder else zoo.OFF)
+  if datasets is not None:
+    shutil.copytree(datasets, home / data_files.DATASETS_FOLDER)
+
+
+@pytest.fixture(scope="module")
+def babbled(tmp_path_factory):
+  """``ROBOT``'s tiny babbling dataset, for the homes where a test trains; the homes that must
+  not train or collect stay empty."""
+  return conftest.babbled_datasets(tmp_path_factory, ROBOT)
 
 
 def no_training(monkeypatch):
@@ -48,7 +61,7 @@ def no_training(monkeypatch):
 
 
 @pytest.fixture(scope="module")
-def trained_zoos(tmp_path_factory):
+def trained_zoos(tmp_path_factory, babbled):
   """Per learned agent (made on first use): a zoo of its tiny seed-0 weights, trained in a home
   of its own, and the trained agent's actions."""
   made = {}
@@ -57,7 +70,7 @@ def trained_zoos(tmp_path_factory):
     if agent_name not in made:
       base = tmp_path_factory.mktemp(f"zoo-{agent_name}")
       with pytest.MonkeyPatch.context() as patched:
-        use(patched, base / "trained")
+        use(patched, base / "trained", datasets=babbled)
         trained = actions(agent_name)
         chosen = catalogue.setting(agent_name, ROBOT, None, "tiny", 1)
         zoo.add([(path, kind) for _, path, kind in catalogue.cache_files(chosen)], {}, base / "zoo")
@@ -141,10 +154,10 @@ def test_a_manifest_path_outside_the_zoo_is_refused(tmp_path):
 
 @pytest.mark.parametrize("agent_name", LEARNED_AGENTS)
 def test_an_unfinished_training_goes_on_from_the_zoo_in_another_home(
-  agent_name, trained_zoos, interrupted_training, tmp_path, monkeypatch, capsys
+  agent_name, trained_zoos, interrupted_training, babbled, tmp_path, monkeypatch, capsys
 ):
   _, uninterrupted = trained_zoos(agent_name)
-  use(monkeypatch, tmp_path / "first")
+  use(monkeypatch, tmp_path / "first", datasets=babbled)
   with interrupted_training():
     actions(agent_name)
   chosen = catalogue.setting(agent_name, ROBOT, None, "tiny", 1)
@@ -157,7 +170,8 @@ def test_an_unfinished_training_goes_on_from_the_zoo_in_another_home(
     if not path.exists() and not path.with_suffix(zoo.PARTIAL_SUFFIX).exists()
   ]
   capsys.readouterr()
-  use(monkeypatch, tmp_path / "second", tmp_path / "zoo")  # Another machine's empty home.
+  # Another machine's home, with the dataset (which the zoo does not carry) but no training.
+  use(monkeypatch, tmp_path / "second", tmp_path / "zoo", datasets=babbled)
   np.testing.assert_array_equal(actions(agent_name), uninterrupted)
   assert "softbench: zoo: resuming the training of" in capsys.readouterr().err
   # Once finished, its checkpoint replaces the training state in the zoo.
@@ -168,11 +182,11 @@ def test_an_unfinished_training_goes_on_from_the_zoo_in_another_home(
   assert zoo.check_files(tmp_path / "zoo") == []
 
 
-def test_the_zoo_refuses_to_outgrow_its_budget(zoo_of, tmp_path, monkeypatch):
+def test_the_zoo_refuses_to_outgrow_its_budget(babbled, zoo_of, tmp_path, monkeypatch):
   folder, _ = zoo_of("mlp")
   before = (folder / zoo.MANIFEST).read_bytes()
   chosen = catalogue.setting("lstm", ROBOT, None, "tiny", 1)
-  use(monkeypatch, tmp_path / "trained")
+  use(monkeypatch, tmp_path / "trained", datasets=babbled)
   actions("lstm")
   with pytest.raises(ValueError, match="over its budget"):
     zoo.add(
@@ -205,8 +219,10 @@ def run_command(results, seeds=2):
   ]
 
 
-def test_cli_run_add_and_verify_reproduce_a_record_from_the_zoo(tmp_path, monkeypatch, capsys):
-  use(monkeypatch, tmp_path / "trained")
+def test_cli_run_add_and_verify_reproduce_a_record_from_the_zoo(
+  babbled, tmp_path, monkeypatch, capsys
+):
+  use(monkeypatch, tmp_path / "trained", datasets=babbled)
   assert cli.main(run_command(tmp_path / "results")) == 0
   ((path, trained),) = records.read_folder(tmp_path / "results")
   folder = tmp_path / "zoo"
@@ -256,8 +272,8 @@ def test_cli_run_add_and_verify_reproduce_a_record_from_the_zoo(tmp_path, monkey
   assert "1 of 1 re-scored seeds identical" in capsys.readouterr().out
 
 
-def test_verify_reports_a_record_the_zoo_does_not_reproduce(tmp_path, monkeypatch, capsys):
-  use(monkeypatch, tmp_path / "trained")
+def test_verify_reports_a_record_the_zoo_does_not_reproduce(babbled, tmp_path, monkeypatch, capsys):
+  use(monkeypatch, tmp_path / "trained", datasets=babbled)
   assert cli.main(run_command(tmp_path / "results", seeds=1)) == 0
   assert (
     cli.main(
