@@ -20,8 +20,6 @@ from softbench import zoo
 from softbench.agents import learned
 from softbench.data import dataset as data_files
 
-_BABBLED = {}  # Robot name -> the datasets folder of a home holding its tiny dataset.
-
 
 @pytest.fixture(autouse=True)
 def no_repository_zoo(monkeypatch):
@@ -29,30 +27,36 @@ def no_repository_zoo(monkeypatch):
   monkeypatch.setenv(zoo.VARIABLE, zoo.OFF)
 
 
-def babbled_datasets(tmp_path_factory, robot: str):
-  """The datasets folder of a data home holding ``robot``'s tiny babbling dataset (data seed
-  ``learned.DATA_SEED``), collected once per test process: collecting it took most of a tiny
-  training's time."""
-  if robot not in _BABBLED:
-    template = tmp_path_factory.mktemp(f"babbled-{robot}")
-    with pytest.MonkeyPatch.context() as patched:
-      patched.setenv("SOFTBENCH_HOME", str(template))
-      data.collect(
-        robot, samples=profiles.get("tiny").samples, seed=learned.DATA_SEED, progress=False
-      )
-    _BABBLED[robot] = template / data_files.DATASETS_FOLDER
-  return _BABBLED[robot]
+@pytest.fixture(scope="session")
+def babbled_datasets(tmp_path_factory):
+  """``of(robot)``: the datasets folder of a data home holding ``robot``'s tiny babbling dataset
+  (data seed ``learned.DATA_SEED``), collected once per test process: collecting it took most of
+  a tiny training's time."""
+  collected = {}
+
+  def of(robot: str):
+    if robot not in collected:
+      template = tmp_path_factory.mktemp(f"babbled-{robot}")
+      with pytest.MonkeyPatch.context() as patched:
+        patched.setenv("SOFTBENCH_HOME", str(template))
+        data.collect(
+          robot, samples=profiles.get("tiny").samples, seed=learned.DATA_SEED, progress=False
+        )
+      collected[robot] = template / data_files.DATASETS_FOLDER
+    return collected[robot]
+
+  return of
 
 
 @pytest.fixture
-def babbled_home(monkeypatch, tmp_path_factory):
+def babbled_home(monkeypatch, babbled_datasets):
   """``into(home, robot="tendon-2")``: makes ``home`` the data home, with a copy of
   ``babbled_datasets``. For tests of what is trained in a home of its own; the dataset's own
   determinism and caching are test_data's subject."""
 
   def into(home, robot="tendon-2"):
     shutil.copytree(
-      babbled_datasets(tmp_path_factory, robot),
+      babbled_datasets(robot),
       home / data_files.DATASETS_FOLDER,
       dirs_exist_ok=True,
     )

@@ -4,7 +4,6 @@ carried to another data home, and records re-scored from it (``softbench zoo``).
 import json
 import shutil
 
-import conftest
 import numpy as np
 import pytest
 
@@ -43,10 +42,10 @@ def use(monkeypatch, home, zoo_folder=None, datasets=None):
 
 
 @pytest.fixture(scope="module")
-def babbled(tmp_path_factory):
+def babbled(babbled_datasets):
   """``ROBOT``'s tiny babbling dataset, for the homes where a test trains; the homes that must
   not train or collect stay empty."""
-  return conftest.babbled_datasets(tmp_path_factory, ROBOT)
+  return babbled_datasets(ROBOT)
 
 
 def no_training(monkeypatch):
