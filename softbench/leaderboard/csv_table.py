@@ -10,6 +10,7 @@ import csv
 import io
 import pathlib
 
+from softbench import records
 from softbench.leaderboard import links
 from softbench.leaderboard import ranking
 
@@ -18,7 +19,7 @@ _SETTING = ("robot", "task", "variant", "agent", "profile", "eval_mode", "seeds"
 _STATISTICS = ("mean", "std", "ci_low", "ci_high")
 HEADER = (
   *_SETTING,
-  *(f"{metric}_{statistic}" for metric in ranking.METRIC_LABELS for statistic in _STATISTICS),
+  *(f"{metric}_{statistic}" for metric in records.METRICS for statistic in _STATISTICS),
   "record",
   "video",
 )
@@ -42,7 +43,7 @@ def render(board: ranking.Leaderboard, out: pathlib.Path) -> str:
       agent, profile, eval_mode = entry.setting
       row = [group.robot, group.task, group.variant, agent, profile, eval_mode]
       row.append(str(entry.record["seeds"]))
-      for metric in ranking.METRIC_LABELS:
+      for metric in records.METRICS:
         row += _figures(entry.estimates.get(metric))
       row += [links.record(entry, out), links.video(entry, out) or ""]
       writer.writerow(row)

@@ -78,15 +78,10 @@ class Board:
 def _figure(estimate: ranking.Estimate | None, paper: float | None = None) -> Cell:
   if estimate is None:
     return Cell("-")
-  decimals = ranking.decimals_of(estimate.mean)
-  interval = None
-  if estimate.interval is not None:
-    low, high = (ranking.number(bound, decimals) for bound in estimate.interval)
-    interval = f"[{low}, {high}]"
   return Cell(
     ranking.mean_and_std(estimate),
     estimate.mean,
-    interval,
+    None if estimate.interval is None else ranking.interval_text(estimate),
     None if paper is None else f"{paper:.2f}",
     figure=True,
   )

@@ -240,9 +240,12 @@ def cell(estimate: Estimate | None) -> str:
   record does not hold."""
   if estimate is None:
     return "-"
-  decimals = decimals_of(estimate.mean)
   text = mean_and_std(estimate)
-  if estimate.interval is not None:
-    low, high = estimate.interval
-    text += f" [{number(low, decimals)}, {number(high, decimals)}]"
-  return text
+  return text if estimate.interval is None else f"{text} {interval_text(estimate)}"
+
+
+def interval_text(estimate: Estimate) -> str:
+  """``[low, high]`` of the bootstrap interval, with the decimals of the mean."""
+  decimals = decimals_of(estimate.mean)
+  low, high = estimate.interval
+  return f"[{number(low, decimals)}, {number(high, decimals)}]"
