@@ -49,6 +49,7 @@ _TASK_RUN_OPTIONS = (
   "task",
   "robot",
   "trajectory",
+  "given",
   "video",
   "module",
   "targets",
@@ -159,6 +160,7 @@ def _run(args: argparse.Namespace) -> None:
     args.targets,
     args.helpers,
     tuple(args.fault),
+    args.given,
   )
   if args.video and settings.adaptive:
     raise ValueError("--video renders one seed's episode; --adaptive draws its own figure")
@@ -173,7 +175,7 @@ def _render(args: argparse.Namespace) -> None:
   seed = video_options.parse_number("seed", args.seed, int)
   seeding.check_seed(seed)
   settings = run_module.settings(
-    args.task, args.agent, args.robot, 1, args.profile, args.eval, args.trajectory
+    args.task, args.agent, args.robot, 1, args.profile, args.eval, args.trajectory, given=args.given
   )
   run_module.render_seed(settings, seed, request)
 
@@ -434,6 +436,12 @@ def build_parser() -> argparse.ArgumentParser:
   _add_eval_argument(run_parser)
   run_parser.add_argument("--trajectory", help="target poses for --task custom (.npy or .csv)")
   run_parser.add_argument(
+    "--given",
+    help="the part of every module's pose the --trajectory file gives: MODULES[:position], "
+    "e.g. 3:position (module 3's position only) or 1,3 (modules 1 and 3, whole poses); "
+    "a learned agent completes the rest (default: every module's whole pose)",
+  )
+  run_parser.add_argument(
     "--module", type=int, help="the module that reaches (--task reach; default 2)"
   )
   run_parser.add_argument(
@@ -449,9 +457,10 @@ def build_parser() -> argparse.ArgumentParser:
   )
   run_parser.add_argument(
     "--helpers",
-    help="what --adaptive asks of the other active modules: "
-    "share (default; the reaching module's error) or "
-    "hold (their starting pose)",
+    help="how a learned agent completes a partial target (reach, --adaptive): "
+    "complete (default; nearest babbling pose refined through its forward models, "
+    "corrected from the measured error), nearest (the nearest babbling pose), "
+    "hold (every other module at its starting pose) or share (the reaching module's error)",
   )
   _add_record_arguments(run_parser)
   run_parser.add_argument("--video", help="also render seed 0's episode to this .mp4 file")
@@ -549,6 +558,9 @@ def build_parser() -> argparse.ArgumentParser:
   _add_profile_argument(render_parser)
   _add_eval_argument(render_parser)
   render_parser.add_argument("--trajectory", help="target poses for --task custom (.npy or .csv)")
+  render_parser.add_argument(
+    "--given", help="the part of every module's pose the --trajectory file gives (as for run)"
+  )
   _add_video_arguments(render_parser)
   render_parser.set_defaults(run=_render)
   retrain_parser = commands.add_parser(

@@ -64,8 +64,10 @@ class RunSettings:
   module: int | None = None  # The reaching module (task reach); None: the task's default.
   adaptive: bool = False
   targets: int | None = None  # Virtual targets of an adaptive run.
-  helpers: str | None = None  # Targets of the other modules in an adaptive run.
+  helpers: str | None = None  # How a learned agent completes partial targets (helper_targets of
+  # LearnedAgent); None: the task gives whole targets, or the agent does not learn from babbling.
   faults: tuple[fault_model.Fault, ...] = ()
+  given: str | None = None  # The part of a custom trajectory's targets its file gives (``Given``).
 
 
 def settings(
@@ -81,16 +83,19 @@ def settings(
   targets: int | None = None,
   helpers: str | None = None,
   faults: tuple[str, ...] = (),
+  given: str | None = None,
 ) -> RunSettings:
-  """Checked settings, with the defaults filled in; ``faults`` as ``MODULE:ACTUATOR:GAIN`` text.
+  """Checked settings, with the defaults filled in; ``faults`` as ``MODULE:ACTUATOR:GAIN`` text,
+  ``given`` as ``suite.trajectories.Given`` text.
 
   Raises:
     ValueError: unknown task, agent, robot, profile or eval mode, seeds < 1, a trajectory
       without the custom task or the custom task without one, an unreadable or malformed
       trajectory file, a module with another task than reach or out of range, adaptive with
-      another task than reach, a non-learned agent or more than one seed, targets or helpers
-      without adaptive, targets < 1, unknown helpers, a malformed fault or one that names no
-      actuator of the robot (one line).
+      another task than reach, a non-learned agent or more than one seed, targets without
+      adaptive, targets < 1, unknown helpers or helpers where nothing is completed, a malformed
+      fault or one that names no actuator of the robot, ``given`` without a trajectory or
+      malformed (one line).
   """
   suite.describe(task)
   agents.describe(agent)
@@ -98,7 +103,7 @@ def settings(
   robot = robot or suite.describe(task).paper_robot
   parsed_faults = tuple(fault_model.parse(text) for text in faults)
   robots.make(robot).with_faults(parsed_faults)
-  _check_adaptive(task, agent, robot, seeds, module, adaptive, targets, helpers)
+  _check_adaptive(task, agent, robot, seeds, module, adaptive, targets)
   if adaptive and parsed_faults:
     raise ValueError("--fault and --adaptive do not go together yet")
   seeds = (1 if adaptive else chosen.seeds) if seeds is None else seeds
@@ -109,12 +114,15 @@ def settings(
     )
   if (trajectory is None) == (task == "custom"):
     raise ValueError("--trajectory goes with --task custom, and --task custom needs one")
+  if given is not None and trajectory is None:
+    raise ValueError("--given goes with --task custom and its --trajectory")
+  if given is not None:
+    given = trajectories.Given.parse(given, robots.make(robot)).text
   if trajectory is not None:  # Read now: a bad file is refused before any collection or training.
-    trajectories.load_trajectory(trajectory, robots.make(robot))
+    trajectories.load_trajectory(trajectory, robots.make(robot), given)
   if adaptive:
     targets = adaptive_activation.DEFAULT_TARGETS if targets is None else targets
-    helpers = adaptive_activation.experiment.DEFAULT_HELPERS if helpers is None else helpers
-  return RunSettings(
+  run = RunSettings(
     task,
     agent,
     robot,
@@ -125,9 +133,11 @@ def settings(
     module,
     adaptive,
     targets,
-    helpers,
+    None,
     parsed_faults,
+    given,
   )
+  return dataclasses.replace(run, helpers=_helpers(run, helpers))
 
 
 def _check_adaptive(
@@ -138,9 +148,8 @@ def _check_adaptive(
   module: int | None,
   adaptive: bool,
   targets: int | None,
-  helpers: str | None,
 ) -> None:
-  """The checks of ``--module``, ``--adaptive``, ``--targets`` and ``--helpers``."""
+  """The checks of ``--module``, ``--adaptive`` and ``--targets``."""
   if module is not None and task != "reach":
     raise ValueError("--module goes with --task reach")
   if module is not None:
@@ -154,18 +163,43 @@ def _check_adaptive(
     )
   if adaptive and seeds not in (None, 1):
     raise ValueError("--adaptive uses one trained agent (seed 0); vary --targets, not --seeds")
-  if (targets is not None or helpers is not None) and not adaptive:
-    raise ValueError("--targets and --helpers go with --adaptive")
+  if targets is not None and not adaptive:
+    raise ValueError("--targets goes with --adaptive")
   if targets is not None:
     dataset.check_count("targets", targets)
-  if helpers is not None:
-    adaptive_activation.experiment.check_helpers(helpers)
+
+
+def _helpers(run: RunSettings, helpers: str | None) -> str | None:
+  """How ``run``'s agent completes its task's partial targets: ``helpers``, or by default
+  ``learned.DEFAULT_HELPER_TARGETS``; None where nothing is completed (whole targets, or an
+  agent that does not learn from babbling).
+
+  Raises:
+    ValueError: unknown ``helpers``, or ``helpers`` where nothing is completed (one line).
+  """
+  if helpers is not None and helpers not in learned.HELPER_TARGETS:
+    raise ValueError(
+      f"unknown helpers {helpers!r}; choose one of {', '.join(learned.HELPER_TARGETS)}"
+    )
+  if suite.gives_whole_targets(run.robot, run.task, **task_options(run)):
+    if helpers is not None:
+      raise ValueError(f"--helpers completes partial targets; task {run.task!r} gives whole ones")
+    return None
+  if agents.learner(run.agent) is None:
+    if helpers is not None:
+      raise ValueError(
+        f"--helpers goes with an agent trained on babbling "
+        f"({', '.join(agents.babbling_learners())}), not {run.agent!r}"
+      )
+    return None
+  return learned.DEFAULT_HELPER_TARGETS if helpers is None else helpers
 
 
 def task_options(run: RunSettings) -> dict:
-  """The options ``suite.load`` gets for ``run``'s task (episode length, trajectory)."""
+  """The options ``suite.load`` gets for ``run``'s task (episode length, trajectory and the
+  part of it given)."""
   if run.task == "custom":
-    return {"trajectory": run.trajectory}
+    return {"trajectory": run.trajectory, **({} if run.given is None else {"given": run.given})}
   options = {} if run.module is None else {"module": run.module}
   return {**options, **suite.length_options(run.task, run.profile.episode_length)}
 
@@ -246,6 +280,8 @@ def episode_on(
   be a faulty robot."""
   if isinstance(agent, learned.LearnedAgent):
     agent.error_source = run.eval_mode
+    if run.helpers is not None:
+      agent.helper_targets = run.helpers
   env = suite.load(arm, run.task, seed=seed, **task_options(run))
   return evaluation.run_episode(env, agent, run.task, show_progress)
 
@@ -424,6 +460,8 @@ def assemble_record(
     "profile_settings": dataclasses.asdict(run.profile),
     "eval_mode": run.eval_mode,
     "trajectory": run.trajectory,
+    **({} if run.given is None else {"given": run.given}),
+    **({} if run.helpers is None or adaptive is not None else {"helpers": run.helpers}),
     "seeds": run.seeds,
     "faults": [fault_model.describe(arm, fault) for fault in run.faults],
     **results,

@@ -122,7 +122,7 @@ def reach_actions(agent, active=None, helpers="hold", seed=0):
   try:
     return evaluation.run_episode(env, agent, "reach").actions
   finally:
-    agent.active_modules, agent.helper_targets = None, "hold"
+    agent.active_modules, agent.helper_targets = None, learned.DEFAULT_HELPER_TARGETS
 
 
 @pytest.mark.parametrize("agent_name", agents.babbling_learners())
@@ -160,12 +160,6 @@ class TestMasking:
 def test_helpers_share_the_error_only_with_active_modules():
   agent = agents.make("smpl", ROBOT, 0, "tiny")
   assert not np.array_equal(reach_actions(agent, None, "share"), reach_actions(agent))
-  # Tracking tasks score every module: no helpers, the conventions agree.
-  env = lambda: suite.load(ROBOT, "circle", seed=0, length=3)
-  agent.helper_targets = "share"
-  shared = evaluation.run_episode(env(), agent, "circle").actions
-  agent.helper_targets = "hold"
-  np.testing.assert_array_equal(shared, evaluation.run_episode(env(), agent, "circle").actions)
 
 
 def test_experiment_runs_the_procedure_in_one_continuous_episode():
@@ -183,7 +177,8 @@ def test_experiment_runs_the_procedure_in_one_continuous_episode():
   # The first stage's error is the mean distance over its steps after the settle step.
   first = np.linalg.norm(outcome.path_mm[2:4] - outcome.target_mm, axis=1).mean()
   assert outcome.stages[0].error == pytest.approx(first, abs=1e-9)
-  assert agent.active_modules is None and agent.helper_targets == "hold"  # Restored.
+  assert agent.active_modules is None  # Restored, with the agent's own helpers:
+  assert agent.helper_targets == learned.DEFAULT_HELPER_TARGETS
 
 
 def test_softbench_run_adaptive_end_to_end(tmp_path, capsys):
@@ -218,7 +213,7 @@ def test_softbench_run_adaptive_end_to_end(tmp_path, capsys):
   assert "-reach-adaptive-tiny-" in path.name
   record = json.loads(path.read_text())
   adaptive = record["adaptive"]
-  assert (adaptive["targets"], adaptive["target_module"], adaptive["helpers"]) == (2, 2, "share")
+  assert (adaptive["targets"], adaptive["target_module"], adaptive["helpers"]) == (2, 2, "complete")
   assert [target["target_seed"] for target in adaptive["per_target"]] == [0, 1]
   assert sum(adaptive["summary"]["final_active"].values()) == 2
   assert adaptive["summary"]["stages"][0]["stage"] == "module 2 alone"
@@ -239,10 +234,13 @@ def test_softbench_run_adaptive_end_to_end(tmp_path, capsys):
       ["--task", "reach", "--agent", "smpl", "--adaptive", "--targets", "0"],
       "targets must be a positive integer",
     ),
-    (["--task", "reach", "--agent", "smpl", "--targets", "3"], "go with --adaptive"),
+    (["--task", "reach", "--agent", "smpl", "--targets", "3"], "goes with --adaptive"),
     (["--task", "reach", "--agent", "zero", "--adaptive"], "needs an agent trained on babbling"),
     (["--task", "reach", "--agent", "smpl", "--adaptive", "--seeds", "3"], "vary --targets"),
     (["--task", "reach", "--agent", "smpl", "--adaptive", "--helpers", "push"], "unknown helpers"),
+    (["--task", "reach", "--agent", "smpl", "--helpers", "push"], "unknown helpers"),
+    (["--task", "circle", "--agent", "smpl", "--helpers", "hold"], "gives whole ones"),
+    (["--task", "reach", "--agent", "zero", "--helpers", "hold"], "trained on babbling"),
     (["--task", "circle", "--agent", "smpl", "--module", "2"], "--module goes with --task reach"),
     (
       ["--task", "reach", "--agent", "smpl", "--adaptive", "--fault", "2:0:0"],
@@ -259,3 +257,43 @@ def test_run_adaptive_refuses_bad_input_with_one_line(argv, message, capsys, tmp
   lines = capsys.readouterr().err.strip().splitlines()
   assert len(lines) == 1 and message in lines[0]
   assert not list(tmp_path.glob("*"))
+
+
+@pytest.mark.parametrize("agent_name", agents.babbling_learners())
+class TestCompletion:
+  """Target completion (``softbench.agents.completion``) in every learned agent."""
+
+  def test_a_reach_goal_is_completed_into_a_whole_arm_target(self, agent_name):
+    agent = agents.make(agent_name, ROBOT, 0, "tiny")
+    env = suite.load(ROBOT, "reach", seed=1, steps=2)
+    first = env.reset().observation
+    for helpers in ("complete", "nearest"):
+      agent.helper_targets = helpers
+      agent.reset(agents.EpisodeInfo("reach", env.task.scored_modules()))
+      action = agent.act(first)
+      target = agent._previous_target
+      assert target.shape == (3, 6) and np.all(np.isfinite(target))
+      np.testing.assert_array_equal(target[1, :3], first["target"][0])  # The goal itself.
+      np.testing.assert_allclose(np.linalg.norm(target[:, 3:], axis=1), 1.0, atol=1e-6)
+      assert np.all(np.abs(action) <= 1.0)
+    agent.helper_targets = learned.DEFAULT_HELPER_TARGETS
+
+  def test_completion_is_deterministic_and_differs_from_hold(self, agent_name):
+    agent = agents.make(agent_name, ROBOT, 0, "tiny")
+    completed = reach_actions(agent, None, "complete")
+    np.testing.assert_array_equal(completed, reach_actions(agent, None, "complete"))
+    np.testing.assert_array_equal(
+      completed, reach_actions(agents.make(agent_name, ROBOT, 0, "tiny"), None, "complete")
+    )
+    assert not np.array_equal(completed, reach_actions(agent, None, "hold"))
+
+  def test_whole_targets_are_used_as_given_bit_for_bit(self, agent_name):
+    agent = agents.make(agent_name, ROBOT, 0, "tiny")
+    env = lambda: suite.load(ROBOT, "circle", seed=0, length=3)
+    runs = []
+    for helpers in learned.HELPER_TARGETS:
+      agent.helper_targets = helpers
+      runs.append(evaluation.run_episode(env(), agent, "circle").actions)
+    agent.helper_targets = learned.DEFAULT_HELPER_TARGETS
+    for actions in runs[1:]:
+      np.testing.assert_array_equal(actions, runs[0])

@@ -10,10 +10,12 @@ carry over from one stage to the next. Every stage lasts ``STAGE_SECONDS``; its 
 position error of the target module's tip over the control steps after ``SETTLE_SECONDS``.
 
 The modules other than the target module get their targets by ``helpers``
-(``LearnedAgent.helper_targets``): ``share`` (default) gives every active one the target
-module's remaining position error and asks the inactive ones for nothing; ``hold`` (the reach
-task's own convention) holds each at its starting pose, so that a switched-on neighbour only
-resists moving.
+(``LearnedAgent.helper_targets``): ``complete`` (default) completes the point into a whole-arm
+pose from the agent's babbling and forward models, with the inactive modules' actions held at
+zero (``softbench.agents.completion``); ``nearest`` takes the nearest babbling pose only;
+``share`` gives every active one the target module's remaining position error and asks the
+inactive ones for nothing; ``hold`` holds each at its starting pose, so that a switched-on
+neighbour only resists moving.
 
 The all-on episode starts from the same state with the same target, runs as many control steps
 as the staged one with every module active, and is scored over its last steps the same way.
@@ -45,7 +47,7 @@ SETTLE_SECONDS = 5.0  # (s) Time after a stage starts before its error counts; t
 THRESHOLD_FRACTION = 0.05  # Error above which the next module is tried: this fraction of the
 # arm's length from the base to the target module's tip (tendon-3 module 2: 5 mm; pneumatic-433
 # module 2: 8 mm).
-DEFAULT_HELPERS = "share"  # Targets of the modules other than the target module (docstring).
+DEFAULT_HELPERS = learned.DEFAULT_HELPER_TARGETS  # Targets of the other modules (docstring).
 
 
 @dataclasses.dataclass(frozen=True)

@@ -183,7 +183,9 @@ def retrain_column(
     learned.Controller(controller.view, forward.cpu().eval(), controller.normalisation)
     for controller, forward in zip(agent.controllers, forwards)
   ]
-  adapted = learned.LearnedAgent(faulty_robot, seed, inverse, controllers, agent.error_source)
+  adapted = learned.LearnedAgent(
+    faulty_robot, seed, inverse, controllers, agent.error_source, agent.candidates
+  )
   return RetrainedColumn(adapted, module, forward_modules, wall_time, trained_now)
 
 

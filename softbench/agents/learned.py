@@ -16,12 +16,15 @@ Acting, at control step t, each controller reads (normalised with its training s
 
 where x*_{t+1} is this step's target and x*_t the previous one; e_0 = 0 and a_{-1} = 0 (SPEC 5).
 ``error_source`` chooses e_t: ``physics`` (the headline), ``model`` (x_t replaced by the forward
-model's prediction, the paper's protocol) or ``open-loop`` (e_t = 0). A position-only target
-keeps the module's starting orientation, as in the paper's reaching experiment. The modules a
-task does not score (reach) get targets by ``helper_targets``: ``hold`` (default) holds each at
-its starting pose; ``share`` (adaptive activation) gives every active one the scored module's
-remaining position error, as its pose now shifted by that error, and asks every inactive one
-for nothing (its pose now).
+model's prediction, the paper's protocol) or ``open-loop`` (e_t = 0).
+
+A target that gives only part of the arm's pose (reach: one module's position; a masked custom
+trajectory) is completed by ``helper_targets``: ``complete`` (default) and ``nearest`` complete
+it from the agent's own babbling and forward models (``softbench.agents.completion``); ``hold``
+holds every module not given at its starting pose and keeps a given module's starting orientation
+if only its position is given; ``share`` gives every active module the scored module's
+remaining position error, as its pose now shifted by that error, and asks every inactive one for
+nothing (its pose now). A target that gives every module's whole pose is used as it is.
 
 ``active_modules`` (1-based; None: every module) switches modules off: their action entries are
 zero (passive: no cable tension, zero pressure). The model still computes every output, so an
@@ -54,13 +57,16 @@ from softbench import profiles
 from softbench import storage
 from softbench import zoo
 from softbench.agents import base
+from softbench.agents import completion
 from softbench.agents import forward_models
 from softbench.agents import hyperparameters
 from softbench.agents import learners
 from softbench.records.fields import ERROR_SOURCES
+from softbench.records.fields import HELPER_TARGETS
 from softbench.robots import base as robot_base
+from softbench.robots import recorder
 
-HELPER_TARGETS = ("hold", "share")
+DEFAULT_HELPER_TARGETS = "complete"
 CHECKPOINT_FOLDER = "checkpoints"
 DATA_SEED = 0  # Every agent and seed learns from the same babbling dataset.
 TRAINING_VERSION = 3  # Bump when training changes, so cached checkpoints are not reused. 2: SMPL
@@ -117,14 +123,29 @@ class LearnedAgent(base.Agent):
     inverse: InverseModel,
     controllers: list[Controller],
     error_source: str = "physics",
+    candidates: Callable[[], completion.Candidates] | None = None,
   ):
+    """``candidates`` builds the babbling poses that complete partial targets (None: this agent
+    cannot complete them; ``helper_targets`` ``hold`` and ``share`` still work)."""
     super().__init__(robot, seed)
     self.inverse = inverse
     self.controllers = controllers
     self.error_source = error_source
+    self.candidates = candidates
     self.active_modules: tuple[int, ...] | None = None
-    self.helper_targets = "hold"
+    self.helper_targets = DEFAULT_HELPER_TARGETS
+    self._completer = completion.Completer(
+      self._babbling_candidates, self._hold_prediction, robot.length, robot.control_timestep
+    )
     self._reset_memory()
+
+  def _babbling_candidates(self) -> completion.Candidates:
+    if self.candidates is None:
+      raise ValueError(
+        f"this {self.robot.name} agent cannot complete a partial target (no babbling data); "
+        f"use helper targets hold or share"
+      )
+    return self.candidates()
 
   def _reset_memory(self) -> None:
     self._previous_target = None  # x*_t, (num_modules, 6)
@@ -132,6 +153,7 @@ class LearnedAgent(base.Agent):
     self._previous_poses = None  # x_{t-1}
     self._poses_before = None  # x_{t-2}
     self._previous_action = np.zeros(self.robot.action_dim)
+    self._completer.reset()
 
   def reset(self, episode: base.EpisodeInfo) -> None:
     if self.error_source not in ERROR_SOURCES:
@@ -149,6 +171,18 @@ class LearnedAgent(base.Agent):
     if self.helper_targets not in HELPER_TARGETS:
       raise ValueError(
         f"helper_targets must be one of {', '.join(HELPER_TARGETS)}, got {self.helper_targets!r}"
+      )
+    if len(self._scored) == self.robot.num_modules and target.shape[1] == 6:
+      return target  # Every module's whole pose is given.
+    if self.helper_targets in ("complete", "nearest"):
+      active_actions = np.repeat(self._module_active(), self.robot.actuators_per_module)
+      return self._completer.complete(
+        target,
+        completion.given_part(self._scored, target.shape[1]),
+        self._previous_poses,
+        poses,
+        active_actions,
+        refine=self.helper_targets == "complete",
       )
     full = self._start_poses.copy()
     if self.helper_targets == "share" and len(self._scored) == 1:
@@ -185,6 +219,41 @@ class LearnedAgent(base.Agent):
     self._poses_before, self._previous_poses = self._previous_poses, poses
     self._previous_action = action
     return action
+
+  def _hold_prediction(
+    self, action: torch.Tensor, previous_poses: np.ndarray, poses: np.ndarray, steps: int
+  ) -> torch.Tensor:
+    """Every module's poses (num_modules, 6) that the forward models predict after holding
+    ``action`` (action_dim,) for ``steps`` control steps from ``previous_poses`` and ``poses``;
+    differentiable in ``action``."""
+    predicted = {}
+    for controller in self.controllers:
+      view, scale = controller.view, controller.normalisation
+      pick = lambda full: _tensor(
+        scale.poses.normalise(view.select(full, self._previous_action)[0])
+      )
+      actuation = torch.cat(
+        [
+          _normalised(action[list(view.preceding_action_indices)], scale.preceding_actions),
+          _normalised(action[list(view.action_indices)], scale.actions),
+        ]
+      )[None]
+      before, now = pick(previous_poses)[None], pick(poses)[None]
+      state = controller.forward.initial_state(1)
+      for _ in range(steps):
+        after, state = controller.forward.step(before, now, actuation, state)
+        before, now = now, after
+      poses_of_view = now[0] * _tensor(scale.poses.half_range) + _tensor(scale.poses.centre)
+      for index, module in enumerate(view.pose_modules):
+        predicted[module] = poses_of_view[
+          index * recorder.POSE_SIZE : (index + 1) * recorder.POSE_SIZE
+        ]
+    if len(predicted) != self.robot.num_modules:
+      raise ValueError(
+        f"this agent's forward models see modules {sorted(m + 1 for m in predicted)} of "
+        f"{self.robot.name}, not every module: it cannot complete a partial target"
+      )
+    return torch.stack([predicted[module] for module in range(self.robot.num_modules)])
 
   def _module_active(self) -> np.ndarray:
     """(num_modules,) whether each module acts (``active_modules``)."""
@@ -230,6 +299,15 @@ class LearnedAgent(base.Agent):
     return smpl_windows.inverse_inputs(
       as_tensor(pick(target)), as_tensor(error), as_tensor(previous_action)
     )
+
+
+def _tensor(values: np.ndarray) -> torch.Tensor:
+  return torch.as_tensor(values, dtype=torch.float32)
+
+
+def _normalised(values: torch.Tensor, normaliser: data.MinMaxNormaliser) -> torch.Tensor:
+  """``normaliser.normalise`` of a tensor, differentiable."""
+  return (values - _tensor(normaliser.centre)) / _tensor(normaliser.half_range)
 
 
 def training_configs(
@@ -584,4 +662,16 @@ def build_agent(
     Controller(view, forward.eval(), scale)
     for view, forward, scale in zip(views, forwards, normalisations)
   ]
-  return LearnedAgent(robot, seed, inverse, controllers)
+  return LearnedAgent(
+    robot, seed, inverse, controllers, candidates=lambda: babbling_candidates(robot, profile)
+  )
+
+
+def babbling_candidates(
+  robot: robot_base.SoftArm, profile: profiles.Profile
+) -> completion.Candidates:
+  """The poses of the babbling an agent of ``profile`` learned from (collected if the data home
+  lacks it), which complete partial targets (``softbench.agents.completion``)."""
+  return completion.Candidates.from_dataset(
+    data.collect(robot, samples=profile.samples, seed=DATA_SEED, progress=False)
+  )

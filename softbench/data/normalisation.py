@@ -45,21 +45,23 @@ class MinMaxNormaliser:
     return len(self.minimum)
 
   @property
-  def _centre(self) -> np.ndarray:
+  def centre(self) -> np.ndarray:
+    """(features,) the middle of each training range; ``normalise`` is (x - centre) / half_range."""
     return (np.asarray(self.maximum) + np.asarray(self.minimum)) / 2
 
   @property
-  def _half_range(self) -> np.ndarray:
+  def half_range(self) -> np.ndarray:
+    """(features,) half of each training range (1 where the range is constant)."""
     half_range = (np.asarray(self.maximum) - np.asarray(self.minimum)) / 2
     return np.where(half_range < CONSTANT_RANGE / 2, 1.0, half_range)
 
   def normalise(self, values: np.ndarray) -> np.ndarray:
     """``values`` (..., features) in normalised units."""
-    return (np.asarray(values, dtype=float) - self._centre) / self._half_range
+    return (np.asarray(values, dtype=float) - self.centre) / self.half_range
 
   def denormalise(self, values: np.ndarray) -> np.ndarray:
     """The inverse of ``normalise``."""
-    return np.asarray(values, dtype=float) * self._half_range + self._centre
+    return np.asarray(values, dtype=float) * self.half_range + self.centre
 
   def to_arrays(self, prefix: str = "") -> dict[str, np.ndarray]:
     return {

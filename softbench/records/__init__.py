@@ -44,7 +44,7 @@ VERSION = 2
 INTEGRITY_FIELD = record_fields.INTEGRITY_FIELD
 """Errors a record may hold per seed; position and normalised tip error always, orientation
 except for position-only tasks (reach)."""
-_OPTIONAL_FIELDS = ("video", "faults", "zoo", "training")
+_OPTIONAL_FIELDS = ("video", "faults", "zoo", "training", "helpers", "given")
 ADAPTIVE_SECTION = "adaptive"  # softbench run --adaptive: per-target results, no per-seed ones.
 _MEAN_TOLERANCE = 1e-9  # Relative: a seed's mean against the mean of its per-module values.
 _MAX_MESSAGE_CHARS = 160  # Of a schema error's message, so that a refusal stays one line.
@@ -88,6 +88,10 @@ def schema() -> dict:
     "task": {"enum": list(suite.TASKS)},
     "eval_mode": {"enum": list(record_fields.ERROR_SOURCES)},
     "trajectory": {"type": ["string", "null"]},
+    "given": {"type": "string", "minLength": 1},  # A custom trajectory's given part (Given.text).
+    # How a learned agent completed partial targets (softbench.agents.learned.HELPER_TARGETS);
+    # records before target completion (2026-12-03) held every module not given ("hold").
+    "helpers": {"enum": list(record_fields.HELPER_TARGETS)},
     "scored_modules": {
       "type": "array",
       "items": {"type": "integer", "minimum": 1},

@@ -17,6 +17,9 @@ METRICS = ("position_mm", "orientation_deg", "normalised_tip_percent")  # Every 
 ERROR_SOURCES = ("physics", "model", "open-loop")
 """What a learned controller's error input is computed from (a record's ``eval_mode``): the
 measured pose, the learned forward model's prediction, or nothing (``softbench.agents.learned``)."""
+HELPER_TARGETS = ("complete", "nearest", "hold", "share")
+"""How a learned agent completes a target that gives only part of the arm's pose (a record's
+``helpers``; ``softbench.agents.learned``, ``softbench.agents.completion``)."""
 AGENT_PATTERN = r"^[a-z0-9][a-z0-9_.-]*$"
 ROBOT_PATTERN = robots.NAME_PATTERN
 MAX_ERROR = 1e6

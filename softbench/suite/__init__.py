@@ -3,8 +3,9 @@
 ``load(robot, task, seed)`` returns a ``dm_control.rl.control.Environment``. Every task exists
 for every robot; ``ALL_TASKS`` lists the (robot, task) pairs of the benchmark robots and
 ``BENCHMARKING`` those tagged ``benchmarking`` (dm_control's convention; so far every one).
-``custom`` follows a user's trajectory (``trajectory=ARRAY_OR_PATH``) and is in neither list, as
-it needs one.
+``custom`` follows a user's trajectory (``trajectory=ARRAY_OR_PATH``; ``given="2:position"``
+when it gives only part of the target, ``trajectories.Given``) and is in neither list, as it
+needs one.
 
 One control step lasts the robot's control period (``robot.control_timestep``): 1 s for the
 tendon arms (1 Hz, the paper's simulator; tendon-5, the slowest, settles in 0.72 s) and 0.2 s
@@ -28,11 +29,14 @@ from softbench.suite import tracking
 from softbench.suite import trajectories
 
 TaskEntry = collections.namedtuple(
-  "TaskEntry", ["build", "tags", "description", "paper_robot", "length_option"]
+  "TaskEntry",
+  ["build", "tags", "description", "paper_robot", "length_option", "partial_targets"],
+  defaults=(None,),
 )
 """A task of the suite: ``build(robot, random=..., **options)``, its tags, a one-line description,
-the robot it runs on in the paper (the default of ``softbench run --robot``) and the option that
-sets its episode length (None: the user's trajectory does)."""
+the robot it runs on in the paper (the default of ``softbench run --robot``), the option that
+sets its episode length (None: the user's trajectory does) and ``partial_targets(robot,
+options)``, whether its targets leave part of the arm's pose out (None: they never do)."""
 
 
 def _reference_task(shape: str) -> Callable[..., base.SoftArmTask]:
@@ -53,17 +57,23 @@ def _reference_task(shape: str) -> Callable[..., base.SoftArmTask]:
 
 
 def _custom_task(
-  robot, trajectory=None, initial_actuation: float = base.INITIAL_ACTUATION, random=None
+  robot,
+  trajectory=None,
+  given: trajectories.Given | str | None = None,
+  initial_actuation: float = base.INITIAL_ACTUATION,
+  random=None,
 ) -> base.SoftArmTask:
   if trajectory is None:
     raise ValueError(
       "task 'custom' needs a trajectory (trajectory=ARRAY_OR_PATH, or --trajectory FILE)"
     )
+  mask = trajectories.as_given(given, robot)
   return tracking.Tracking(
     robot,
-    trajectories.load_trajectory(trajectory, robot),
+    trajectories.load_trajectory(trajectory, robot, mask),
     initial_actuation=initial_actuation,
     random=random,
+    given=mask,
   )
 
 
@@ -103,6 +113,7 @@ _TASKS = {
     "bring one module's tip to a virtual point (position only)",
     "pneumatic-433",
     "steps",
+    lambda robot, options: True,
   ),
   "custom": TaskEntry(
     _custom_task,
@@ -110,6 +121,10 @@ _TASKS = {
     "follow your own trajectory (.npy or .csv, one target per row)",
     "tendon-3",
     None,
+    lambda robot, options: (
+      trajectories.as_given(options.get("given"), robot)
+      not in (None, trajectories.Given.whole(robot))
+    ),
   ),
 }
 TASKS = tuple(_TASKS)
@@ -172,6 +187,15 @@ def length_options(task: str, steps: int | None) -> dict:
   return {} if steps is None or option is None else {option: steps}
 
 
+def gives_whole_targets(robot: str | robots.SoftArm, task: str, **task_kwargs) -> bool:
+  """Whether ``task`` (with these options) gives every module's whole pose as its target
+  (``TaskEntry.partial_targets``); a learned agent completes any other target
+  (``softbench.agents.completion``)."""
+  partial = describe(task).partial_targets
+  arm = robots.make(robot) if isinstance(robot, str) else robot
+  return partial is None or not partial(arm, task_kwargs)
+
+
 def load(
   robot: str | robots.SoftArm,
   task: str,
@@ -190,7 +214,7 @@ def load(
     seed: seed of the task's random start (an int, a ``numpy.random.RandomState`` or None).
     environment_kwargs: extra keyword arguments of ``control.Environment``.
     **task_kwargs: the task's options, e.g. ``length`` (tracking), ``module`` and ``steps``
-      (reach), ``trajectory`` (custom), ``initial_actuation`` (all).
+      (reach), ``trajectory`` and ``given`` (custom), ``initial_actuation`` (all).
 
   Raises:
     ValueError: unknown robot or task, an invalid task option, or a seed that is not an integer
@@ -222,6 +246,7 @@ __all__ = [
   "TASKS",
   "TaskEntry",
   "describe",
+  "gives_whole_targets",
   "length_options",
   "load",
   "register",

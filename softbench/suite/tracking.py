@@ -1,17 +1,21 @@
 """Trajectory tracking: every module follows a sequence of target poses, one per control step.
 
 The targets come from a reference the robot traced itself (``references``) or from the user
-(``trajectories``). The episode lasts one control step per target.
+(``trajectories``), who may give only part of them (``trajectories.Given``: some modules, with
+or without orientation); only the given modules are shown and scored. The episode lasts one
+control step per target.
 """
 
 import numpy as np
 
 from softbench.robots import base as robot_base
 from softbench.suite import base
+from softbench.suite import trajectories
 
 
 class Tracking(base.SoftArmTask):
-  """Follow ``targets`` (steps, num_modules, 6) with every module."""
+  """Follow ``targets`` (steps, num_modules, 6) with every module, or, with ``given``, targets
+  (steps, len(given.modules), given.size) with the given modules."""
 
   def __init__(
     self,
@@ -19,11 +23,16 @@ class Tracking(base.SoftArmTask):
     targets: np.ndarray,
     initial_actuation: float = base.INITIAL_ACTUATION,
     random=None,
+    given: trajectories.Given | str | None = None,
   ):
     super().__init__(robot, initial_actuation, random)
+    given = trajectories.as_given(given, robot)
+    self.given = trajectories.Given.whole(robot) if given is None else given
+    self.target_size = self.given.size
+    shape = (len(self.given.modules), self.given.size)
     targets = np.asarray(targets, dtype=float)
-    if targets.ndim != 3 or targets.shape[1:] != (robot.num_modules, 6) or len(targets) == 0:
-      raise ValueError(f"targets must be (steps, {robot.num_modules}, 6), got {targets.shape}")
+    if targets.ndim != 3 or targets.shape[1:] != shape or len(targets) == 0:
+      raise ValueError(f"targets must be (steps, {shape[0]}, {shape[1]}), got {targets.shape}")
     self._targets = targets
 
   @property
@@ -35,4 +44,4 @@ class Tracking(base.SoftArmTask):
     return self._targets[min(step, len(self._targets) - 1)].copy()
 
   def scored_modules(self) -> tuple[int, ...]:
-    return tuple(range(1, self.robot.num_modules + 1))
+    return self.given.modules

@@ -4,9 +4,15 @@ A row lists every module's target pose in module order: tip position (m, world f
 at the origin and the arm hanging along -z) then unit orientation vector, so a row of an
 N-module arm has 6N numbers. A ``.csv`` file has no header; lines starting with ``#`` are
 comments. An array may also be given as (steps, N, 6).
+
+A trajectory may give only part of the target (``Given``, e.g. ``"1,3"`` or ``"2:position"``):
+then a row lists, for each given module in ascending order, its tip position and, unless the
+mask says ``:position``, its unit orientation vector; the other modules are free.
 """
 
+import dataclasses
 import pathlib
+import re
 import warnings
 
 import numpy as np
@@ -16,6 +22,110 @@ from softbench.robots import base
 UNIT_TOLERANCE = 1e-3  # Largest accepted | |orientation vector| - 1 |.
 REACH_FACTOR = 2.0  # A target position lies within this many arm lengths of the base; farther
 # is no place the arm can mean (1e300 once ran every episode, then failed writing the record).
+POSITION_SUFFIX = ":position"  # Ends a mask that gives positions only.
+POSE_SIZE = 6  # Entries of a module's whole target: position (m) and unit orientation vector.
+POSITION_SIZE = 3  # Entries of a position-only target (m).
+_MODULE_LIST = re.compile(r"\s*[0-9]+\s*(,\s*[0-9]+\s*)*")
+
+
+@dataclasses.dataclass(frozen=True)
+class Given:
+  """Which part of the target a trajectory gives: some modules (1-based, ascending), with or
+  without their orientation vectors. Text form: ``"1,3"`` (pose), ``"2:position"``."""
+
+  modules: tuple[int, ...]
+  orientation: bool = True
+
+  def __post_init__(self):
+    modules = self.modules
+    if not isinstance(modules, tuple) or not modules:
+      raise ValueError(f"given modules must be a non-empty tuple, got {modules!r}")
+    if not all(isinstance(k, int) and not isinstance(k, bool) and k >= 1 for k in modules):
+      raise ValueError(f"given modules must be 1-based module numbers, got {modules!r}")
+    if len(set(modules)) != len(modules):
+      raise ValueError(f"given modules must not repeat, got {_join(modules)}")
+    if list(modules) != sorted(modules):
+      raise ValueError(f"given modules must be in ascending order, got {_join(modules)}")
+    if not isinstance(self.orientation, bool):
+      raise ValueError(f"given orientation must be True or False, got {self.orientation!r}")
+
+  @classmethod
+  def parse(cls, text: str, robot: base.SoftArm) -> "Given":
+    """The mask of ``text``: modules separated by commas, then ``:position`` for positions only.
+
+    Raises:
+      ValueError: malformed text, a module outside 1..num_modules or a repeated one (one line).
+    """
+    if not isinstance(text, str):
+      raise ValueError(f"given must be text such as '1,3' or '2:position', got {text!r}")
+    listed = text.strip()
+    orientation = not listed.endswith(POSITION_SUFFIX)
+    if not orientation:
+      listed = listed[: -len(POSITION_SUFFIX)]
+    if not _MODULE_LIST.fullmatch(listed):
+      raise ValueError(
+        f"given must list modules separated by commas, optionally followed by "
+        f"'{POSITION_SUFFIX}' (e.g. '1,3' or '2:position'), got {text!r}"
+      )
+    modules = tuple(int(k) for k in listed.split(","))
+    for module in modules:
+      _check_module(module, robot)
+    return cls(modules, orientation)
+
+  @classmethod
+  def whole(cls, robot: base.SoftArm) -> "Given":
+    """Every module of ``robot``, with orientation: the whole target."""
+    return cls(tuple(range(1, robot.num_modules + 1)), True)
+
+  def check(self, robot: base.SoftArm) -> "Given":
+    """This mask, if every module is one of ``robot``'s.
+
+    Raises:
+      ValueError: a module beyond ``robot.num_modules`` (one line).
+    """
+    _check_module(self.modules[-1], robot)
+    return self
+
+  @property
+  def size(self) -> int:
+    """Entries per given module: 6 (position, orientation) or 3 (position)."""
+    return POSE_SIZE if self.orientation else POSITION_SIZE
+
+  @property
+  def text(self) -> str:
+    """The text form, as ``parse`` reads it."""
+    return _join(self.modules) + ("" if self.orientation else POSITION_SUFFIX)
+
+  def part(self, poses: np.ndarray) -> np.ndarray:
+    """The given entries of whole poses (..., num_modules, 6): (..., len(modules), size)."""
+    poses = np.asarray(poses)
+    return poses[..., np.array(self.modules) - 1, : self.size]
+
+
+def _check_module(module: int, robot: base.SoftArm) -> None:
+  if not 1 <= module <= robot.num_modules:
+    raise ValueError(
+      f"given module {module} is not a module of {robot.name} (1 to {robot.num_modules})"
+    )
+
+
+def _join(modules) -> str:
+  return ",".join(str(k) for k in modules)
+
+
+def as_given(given, robot: base.SoftArm) -> Given | None:
+  """``given`` (None, a ``Given`` or its text) as a ``Given`` checked against ``robot``.
+
+  Raises:
+    ValueError: malformed text, a module ``robot`` lacks, or another type (one line).
+  """
+  if given is None:
+    return None
+  if isinstance(given, Given):
+    return given.check(robot)
+  if isinstance(given, str):
+    return Given.parse(given, robot)
+  raise ValueError(f"given must be None, a Given or text such as '2:position', got {given!r}")
 
 
 def _read(path: pathlib.Path) -> np.ndarray:
@@ -35,19 +145,30 @@ def _read(path: pathlib.Path) -> np.ndarray:
   raise ValueError(f"trajectory file {path} must be .npy or .csv")
 
 
-def load_trajectory(source, robot: base.SoftArm) -> np.ndarray:
-  """Target poses (steps, num_modules, 6) from an array or a file path.
+def load_trajectory(source, robot: base.SoftArm, given: Given | str | None = None) -> np.ndarray:
+  """Target poses (steps, num_modules, 6) from an array or a file path; with ``given``, only the
+  given part: (steps, len(given.modules), given.size).
 
   Raises:
     ValueError: unreadable file, wrong shape (the message names the expected one), non-finite
-      values, a position farther than ``REACH_FACTOR`` arm lengths from the base, or
-      orientation vectors that are not unit length.
+      values, a position farther than ``REACH_FACTOR`` arm lengths from the base, given
+      orientation vectors that are not unit length, or a malformed ``given``.
   """
-  modules = robot.num_modules
-  expected = (
-    f"(steps, {6 * modules}): per row, each of the {modules} module(s)' tip position "
-    f"(m) and unit orientation vector"
-  )
+  mask = as_given(given, robot)
+  if mask is None:
+    modules, size = robot.num_modules, POSE_SIZE
+    expected = (
+      f"(steps, {size * modules}): per row, each of the {modules} module(s)' tip position "
+      f"(m) and unit orientation vector"
+    )
+  else:
+    modules, size = len(mask.modules), mask.size
+    entries = (
+      "tip position (m) and unit orientation vector" if mask.orientation else "tip position (m)"
+    )
+    expected = (
+      f"(steps, {size * modules}): per row, the {entries} of given module(s) {_join(mask.modules)}"
+    )
   if isinstance(source, (str, pathlib.Path)):
     array = _read(pathlib.Path(source))
   else:
@@ -55,23 +176,18 @@ def load_trajectory(source, robot: base.SoftArm) -> np.ndarray:
   if not np.issubdtype(array.dtype, np.number) or np.iscomplexobj(array):
     raise ValueError(f"trajectory must hold real numbers, got dtype {array.dtype}")
   array = array.astype(float)
-  if array.ndim == 3 and array.shape[1:] == (modules, 6):
+  if array.ndim == 3 and array.shape[1:] == (modules, size):
     targets = array
-  elif array.ndim == 2 and array.shape[1] == 6 * modules:
-    targets = array.reshape(len(array), modules, 6)
+  elif array.ndim == 2 and array.shape[1] == size * modules:
+    targets = array.reshape(len(array), modules, size)
   else:
     raise ValueError(f"trajectory for {robot.name} must have shape {expected}; got {array.shape}")
   if len(targets) == 0:
     raise ValueError(f"trajectory for {robot.name} has no rows; expected shape {expected}")
   if not np.all(np.isfinite(targets)):
     raise ValueError("trajectory contains NaN or infinite values")
-  if np.any(np.abs(targets[..., 3:]) > 1.0 + UNIT_TOLERANCE):  # Before squaring: 1e300 overflows.
-    row = int(np.argwhere(np.abs(targets[..., 3:]) > 1.0 + UNIT_TOLERANCE)[0, 0])
-    raise ValueError(f"trajectory row {row}: orientation vectors must have unit length")
-  norms = np.linalg.norm(targets[..., 3:], axis=-1)
-  if np.any(np.abs(norms - 1.0) > UNIT_TOLERANCE):
-    row = int(np.argwhere(np.abs(norms - 1.0) > UNIT_TOLERANCE)[0, 0])
-    raise ValueError(f"trajectory row {row}: orientation vectors must have unit length")
+  if size == POSE_SIZE:
+    _check_unit(targets[..., 3:])
   limit = REACH_FACTOR * robot.length
   far = np.abs(targets[..., :3]).max(axis=(1, 2)) > limit
   if np.any(far):
@@ -81,3 +197,14 @@ def load_trajectory(source, robot: base.SoftArm) -> np.ndarray:
       f"{robot.name}; positions are in m"
     )
   return targets
+
+
+def _check_unit(axes: np.ndarray) -> None:
+  """Refuses orientation vectors (steps, modules, 3) that are not unit length."""
+  if np.any(np.abs(axes) > 1.0 + UNIT_TOLERANCE):  # Before squaring: 1e300 overflows.
+    row = int(np.argwhere(np.abs(axes) > 1.0 + UNIT_TOLERANCE)[0, 0])
+    raise ValueError(f"trajectory row {row}: orientation vectors must have unit length")
+  norms = np.linalg.norm(axes, axis=-1)
+  if np.any(np.abs(norms - 1.0) > UNIT_TOLERANCE):
+    row = int(np.argwhere(np.abs(norms - 1.0) > UNIT_TOLERANCE)[0, 0])
+    raise ValueError(f"trajectory row {row}: orientation vectors must have unit length")
