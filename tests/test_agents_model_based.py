@@ -89,19 +89,17 @@ def tip_error_percent(
 @pytest.mark.parametrize("robot", robots.BENCHMARK_ROBOTS)
 @pytest.mark.parametrize("name", UNTRAINED_AGENTS)
 class TestEveryAgent:
-  def test_actions_are_finite_and_in_bounds(self, name, robot):
-    actions = reach_episode(name, robot).actions
-    assert actions.shape == (REACH_STEPS, robots.make(robot).action_dim)
-    assert np.all(np.isfinite(actions))
-    assert np.all(np.abs(actions) <= 1.0)
-
-  def test_same_seed_same_actions(self, name, robot):
+  def test_actions_are_finite_in_bounds_the_same_for_a_seed_and_leave_the_physics(
+    self, name, robot
+  ):
+    episode = reach_episode(name, robot)
+    assert episode.actions.shape == (REACH_STEPS, robots.make(robot).action_dim)
+    assert np.all(np.isfinite(episode.actions))
+    assert np.all(np.abs(episode.actions) <= 1.0)
+    assert episode.untouched  # The agent never changed the environment while acting.
     env = suite.load(robot, "reach", seed=0, steps=REACH_STEPS)
     again = run_episode(agents.make(name, robot, 0), env, "reach")
-    np.testing.assert_array_equal(again.actions, reach_episode(name, robot).actions)
-
-  def test_never_changes_the_environment_while_acting(self, name, robot):
-    assert reach_episode(name, robot).untouched
+    np.testing.assert_array_equal(again.actions, episode.actions)
 
 
 def test_zero_agent_acts_zeros():

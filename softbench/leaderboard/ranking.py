@@ -102,8 +102,11 @@ class Entry:
   @property
   def shown_setting(self) -> tuple[str, str, str]:
     """``setting`` as tables show it: an agent that learned by acting (a ``training`` section)
-    with its environment steps and mean training wall time per seed."""
+    with its environment steps and mean training wall time per seed; one that completed partial
+    targets with how (``helpers``; none said: ``hold``)."""
     agent, profile, eval_mode = self.setting
+    if "helpers" in self.record:
+      agent += f" (helpers {self.record['helpers']})"
     spent = self.record.get("training", {}).get("per_seed", [])
     if spent and all("environment_steps" in seed for seed in spent):
       steps = {seed["environment_steps"] for seed in spent}
