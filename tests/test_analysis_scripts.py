@@ -174,3 +174,20 @@ def test_plant_comparison_sets_both_robots_side_by_side(monkeypatch, capsys):
   assert re.fullmatch(r"[0-9.]+ ± [0-9.]+", first) and re.fullmatch(r"[0-9.]+ ± [0-9.]+", second)
   ranked = re.search(r"^spiral on tendon-local-3, learned agents from best: (.+)$", out, re.M)
   assert "smpl" in ranked.group(1)
+
+
+def test_reach_completion_reports_every_mode_of_every_agent(monkeypatch, capsys, tmp_path):
+  out_file = tmp_path / "table.json"
+  out = run_script(
+    "reach_completion",
+    ["--robot", "tendon-1", "--agents", "mlp", "--profile", "tiny", "--targets", "2"]
+    + ["--out", str(out_file)],
+    monkeypatch,
+    capsys,
+  )
+  table = json.loads(out_file.read_text())
+  assert list(table) == [f"mlp {helpers}" for helpers in ("complete", "nearest", "hold", "share")]
+  for row in table.values():
+    low, median, high = row["episode_mean_mm"]
+    assert 0 <= low <= median <= high and len(row["final_mm"]) == 3
+  assert out.count("(quartiles over 2 targets)") == 4
