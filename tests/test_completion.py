@@ -161,3 +161,14 @@ def test_a_masked_custom_run_is_completed_and_the_record_says_how(tmp_path, babb
   circle_argv = ["run", "--task", "circle", "--robot", "tendon-2", "--agent", "mlp"]
   assert cli.main([*circle_argv, "--given", "2", "--results", str(tmp_path)]) == cli.EXIT_USAGE
   assert "--given goes with --task custom" in capsys.readouterr().err
+
+
+def test_without_measured_feedback_a_still_goal_is_not_corrected():
+  part = completion.Part((1,), 3)
+  goal = np.array([[0.05, 0.0, -0.2]])
+  found = completer()
+  measured = np.zeros((MODULES, 6))
+  measured[1, :3] = goal[0] - [0.01, 0.0, 0.0]
+  for _ in range(int(np.ceil(completion.HOLD_SECONDS / TIMESTEP)) + 3):
+    target = found.complete(goal, part, measured, measured, np.ones(ACTIONS, bool), False, False)
+    np.testing.assert_array_equal(target[1, :3], goal[0])

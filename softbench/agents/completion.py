@@ -134,17 +134,19 @@ class Completer:
     poses: np.ndarray,
     active_actions: np.ndarray,
     refine: bool = True,
+    correct: bool = True,
   ) -> np.ndarray:
     """The whole-arm target (num_modules, 6) for ``goal`` (len(part.modules), part.size), the
     arm now at ``poses`` after ``previous_poses``; entries of the action outside
-    ``active_actions`` (a boolean mask) stay zero."""
+    ``active_actions`` (a boolean mask) stay zero. ``correct``: whether a still goal is corrected
+    from the measured error (stage 3; not when the agent acts without measured feedback)."""
     goal = np.asarray(goal, dtype=float)
     if self._goal is None or not np.array_equal(goal, self._goal):
       self._goal, self._still_steps = goal.copy(), 0
       self._correction = np.zeros((len(part.modules), 3))
     else:
       self._still_steps += 1
-    if self._still_steps >= self._hold_steps:
+    if correct and self._still_steps >= self._hold_steps:
       error = goal[:, POSITION] - part.of(poses)[:, POSITION]
       self._correction = _clip_norms(
         self._correction + self._gain * error, MAX_CORRECTION_ARM_LENGTHS * self._arm_length

@@ -20,11 +20,12 @@ model's prediction, the paper's protocol) or ``open-loop`` (e_t = 0).
 
 A target that gives only part of the arm's pose (reach: one module's position; a masked custom
 trajectory) is completed by ``helper_targets``: ``complete`` (default) and ``nearest`` complete
-it from the agent's own babbling and forward models (``softbench.agents.completion``); ``hold``
-holds every module not given at its starting pose and keeps a given module's starting orientation
-if only its position is given; ``share`` gives every active module the scored module's
-remaining position error, as its pose now shifted by that error, and asks every inactive one for
-nothing (its pose now). A target that gives every module's whole pose is used as it is.
+it from the agent's own babbling and forward models (``softbench.agents.completion``; corrected
+from the measured error only with ``error_source`` ``physics``); ``hold`` holds every module not
+given at its starting pose and keeps a given module's starting orientation if only its position
+is given; ``share`` gives every active module the scored module's remaining position error, as
+its pose now shifted by that error, and asks every inactive one for nothing (its pose now). A
+target that gives every module's whole pose is used as it is.
 
 ``active_modules`` (1-based; None: every module) switches modules off: their action entries are
 zero (passive: no cable tension, zero pressure). The model still computes every output, so an
@@ -183,6 +184,7 @@ class LearnedAgent(base.Agent):
         poses,
         active_actions,
         refine=self.helper_targets == "complete",
+        correct=self.error_source == "physics",
       )
     full = self._start_poses.copy()
     if self.helper_targets == "share" and len(self._scored) == 1:
