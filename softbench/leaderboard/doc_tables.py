@@ -149,15 +149,20 @@ def comparison_table(first: Setting, second: Setting) -> Callable[[ranking.Leade
 
     def cell(where: Setting, task: str, agent: str) -> str:
       entry = found.get((where, task, agent))
-      return "-" if entry is None else ranking.mean_and_std(entry.estimates[METRIC])
+      if entry is None:
+        return "-"
+      return ranking.mean_and_std(entry.estimates[METRIC]) + entry.completion_mark
 
+    marked = any(
+      entry.completion_mark for (where, _, _), entry in found.items() if where in (first, second)
+    )
     rows = tuple(
       (agent, *(f"{cell(first, task, agent)} -> {cell(second, task, agent)}" for task in columns))
       for agent in _agents_in(agent for _, agent in shown)
     )
     return Table(
       f"position error (mm), mean ± std over seeds of the module-averaged error: "
-      f"{first} -> {second}",
+      f"{first} -> {second}" + (f"; {ranking.COMPLETED_NOTE}" if marked else ""),
       ("agent", *columns),
       rows,
       label_columns=1,

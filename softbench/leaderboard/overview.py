@@ -53,19 +53,23 @@ class Overview:
     return f"overview-{self.robot}-{self.profile}-{self.eval_mode}"
 
 
-def _cell(estimate: ranking.Estimate, reference: float | None) -> str:
-  text = ranking.mean_and_std(estimate)
+def _cell(estimate: ranking.Estimate, reference: float | None, mark: str = "") -> str:
+  text = ranking.mean_and_std(estimate) + mark
   return text if reference is None else f"{text} ({reference:.2f})"
 
 
 def overviews(board: ranking.Leaderboard) -> tuple[Overview, ...]:
   """The overview of every robot, profile and eval mode with a plain-task record on ``board``."""
   cells: dict[tuple[str, str, str], dict[tuple[str, str], ranking.Estimate]] = {}
+  marks: dict[tuple[str, str, str], dict[tuple[str, str], str]] = {}
   for group, entry in ranking.plain_entries(board):
     agent, profile, eval_mode = entry.setting
     cells.setdefault((group.robot, profile, eval_mode), {})[agent, group.task] = entry.estimates[
       METRIC
     ]
+    marks.setdefault((group.robot, profile, eval_mode), {})[agent, group.task] = (
+      entry.completion_mark
+    )
   tables = []
   for (robot, profile, eval_mode), estimates in cells.items():  # Already in the groups' order.
     tasks = sorted({task for _, task in estimates}, key=suite.TASKS.index)
@@ -78,6 +82,8 @@ def overviews(board: ranking.Leaderboard) -> tuple[Overview, ...]:
       if experiment
       else "the paper has no table for this robot"
     )
+    if any(marks[robot, profile, eval_mode].values()):
+      caption += f"; {ranking.COMPLETED_NOTE}"
     missing = [agent for agent in agents.AGENTS if agent not in names]
     if missing:
       caption += f"; no record yet of {', '.join(missing)}"
@@ -85,7 +91,11 @@ def overviews(board: ranking.Leaderboard) -> tuple[Overview, ...]:
       (
         agent,
         *(
-          _cell(estimates[agent, task], paper_mean(robot, task, agent))
+          _cell(
+            estimates[agent, task],
+            paper_mean(robot, task, agent),
+            marks[robot, profile, eval_mode][agent, task],
+          )
           if (agent, task) in estimates
           else "-"
           for task in tasks

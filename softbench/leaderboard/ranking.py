@@ -73,6 +73,11 @@ def _bootstrap_interval(values: np.ndarray) -> tuple[float, float] | None:
   return float(result.confidence_interval.low), float(result.confidence_interval.high)
 
 
+COMPLETING_HELPERS = ("complete", "nearest")  # softbench.agents.completion
+COMPLETED_MARK = "†"
+COMPLETED_NOTE = f"{COMPLETED_MARK}: the agent completed the partial target (target completion)"
+
+
 @dataclasses.dataclass(frozen=True)
 class Entry:
   """One record as the leaderboard shows it."""
@@ -98,6 +103,12 @@ class Entry:
   @property
   def label(self) -> str:
     return " / ".join(self.setting)
+
+  @property
+  def completion_mark(self) -> str:
+    """``COMPLETED_MARK`` after a figure whose agent completed partial targets from what it
+    learned (``helpers`` complete or nearest), else nothing."""
+    return COMPLETED_MARK if self.record.get("helpers") in COMPLETING_HELPERS else ""
 
   @property
   def shown_setting(self) -> tuple[str, str, str]:
