@@ -177,10 +177,8 @@ def _helpers(run: RunSettings, helpers: str | None) -> str | None:
   Raises:
     ValueError: unknown ``helpers``, or ``helpers`` where nothing is completed (one line).
   """
-  if helpers is not None and helpers not in learned.HELPER_TARGETS:
-    raise ValueError(
-      f"unknown helpers {helpers!r}; choose one of {', '.join(learned.HELPER_TARGETS)}"
-    )
+  if helpers is not None:
+    adaptive_activation.experiment.check_helpers(helpers)
   if suite.gives_whole_targets(run.robot, run.task, **task_options(run)):
     if helpers is not None:
       raise ValueError(f"--helpers completes partial targets; task {run.task!r} gives whole ones")

@@ -18,12 +18,12 @@ import warnings
 import numpy as np
 
 from softbench.robots import base
+from softbench.robots import recorder
 
 UNIT_TOLERANCE = 1e-3  # Largest accepted | |orientation vector| - 1 |.
 REACH_FACTOR = 2.0  # A target position lies within this many arm lengths of the base; farther
 # is no place the arm can mean (1e300 once ran every episode, then failed writing the record).
 POSITION_SUFFIX = ":position"  # Ends a mask that gives positions only.
-POSE_SIZE = 6  # Entries of a module's whole target: position (m) and unit orientation vector.
 POSITION_SIZE = 3  # Entries of a position-only target (m).
 _MODULE_LIST = re.compile(r"\s*[0-9]+\s*(,\s*[0-9]+\s*)*")
 
@@ -89,7 +89,7 @@ class Given:
   @property
   def size(self) -> int:
     """Entries per given module: 6 (position, orientation) or 3 (position)."""
-    return POSE_SIZE if self.orientation else POSITION_SIZE
+    return recorder.POSE_SIZE if self.orientation else POSITION_SIZE
 
   @property
   def text(self) -> str:
@@ -156,7 +156,7 @@ def load_trajectory(source, robot: base.SoftArm, given: Given | str | None = Non
   """
   mask = as_given(given, robot)
   if mask is None:
-    modules, size = robot.num_modules, POSE_SIZE
+    modules, size = robot.num_modules, recorder.POSE_SIZE
     expected = (
       f"(steps, {size * modules}): per row, each of the {modules} module(s)' tip position "
       f"(m) and unit orientation vector"
@@ -186,7 +186,7 @@ def load_trajectory(source, robot: base.SoftArm, given: Given | str | None = Non
     raise ValueError(f"trajectory for {robot.name} has no rows; expected shape {expected}")
   if not np.all(np.isfinite(targets)):
     raise ValueError("trajectory contains NaN or infinite values")
-  if size == POSE_SIZE:
+  if size == recorder.POSE_SIZE:
     _check_unit(targets[..., 3:])
   limit = REACH_FACTOR * robot.length
   far = np.abs(targets[..., :3]).max(axis=(1, 2)) > limit
