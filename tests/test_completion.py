@@ -13,6 +13,7 @@ from softbench import suite
 from softbench.agents import completion
 from softbench.data import dataset
 from softbench.data import splits
+from softbench.suite import trajectories
 
 ARM_LENGTH = 0.3  # (m)
 TIMESTEP = 0.5  # (s)
@@ -50,26 +51,28 @@ def completer(candidates=None, predict=None) -> completion.Completer:
   )
 
 
-def complete(completer, goal, part, refine=True, poses=None, active=None):
+def complete(completer, goal, given, refine=True, poses=None, active=None):
   poses = np.zeros((MODULES, 6)) if poses is None else poses
   active = np.ones(ACTIONS, bool) if active is None else active
-  return completer.complete(goal, part, poses, poses, active, refine=refine)
+  return completer.complete(goal, given, poses, poses, active, refine=refine)
 
 
-@pytest.mark.parametrize("part", [completion.Part((1,), 3), completion.Part((0, 2), 6)])
-def test_the_nearest_pose_is_the_brute_force_nearest_in_arm_lengths(part):
+@pytest.mark.parametrize(
+  "given", [trajectories.Given((2,), orientation=False), trajectories.Given((1, 3))]
+)
+def test_the_nearest_pose_is_the_brute_force_nearest_in_arm_lengths(given):
   candidates = random_candidates()
   rng = np.random.default_rng(1)
   for _ in range(20):
-    goal = rng.uniform(-ARM_LENGTH, ARM_LENGTH, (len(part.modules), part.size))
-    target = complete(completer(candidates), goal, part, refine=False)
-    scale = np.ones(part.size)
+    goal = rng.uniform(-ARM_LENGTH, ARM_LENGTH, (len(given.modules), given.size))
+    target = complete(completer(candidates), goal, given, refine=False)
+    scale = np.ones(given.size)
     scale[:3] = 1 / ARM_LENGTH
     distances = np.linalg.norm(
-      ((part.of(candidates.poses) - goal) * scale).reshape(len(candidates.poses), -1), axis=1
+      ((given.part(candidates.poses) - goal) * scale).reshape(len(candidates.poses), -1), axis=1
     )
     expected = candidates.poses[np.argmin(distances)].copy()
-    expected[list(part.modules), : part.size] = goal
+    expected[given.indices, : given.size] = goal
     np.testing.assert_array_equal(target, expected)
 
 
@@ -88,27 +91,27 @@ def test_refinement_meets_a_reachable_goal_through_the_model():
   predict = linear_arm()
   wanted_action = torch.tensor([0.3, -0.5, 0.2, 0.6])
   goal = predict(wanted_action, None, None, 1)[1:2, :3].numpy().astype(float)
-  part = completion.Part((1,), 3)
-  target = complete(completer(predict=predict), goal, part)
+  given = trajectories.Given((2,), orientation=False)
+  target = complete(completer(predict=predict), goal, given)
   np.testing.assert_array_equal(target[1, :3], goal[0])
   # The other modules' targets are where the model puts them for an action that meets the goal.
   refined = completer(predict=predict)
-  refined.complete(goal, part, np.zeros((MODULES, 6)), np.zeros((MODULES, 6)), np.ones(4, bool))
+  refined.complete(goal, given, np.zeros((MODULES, 6)), np.zeros((MODULES, 6)), np.ones(4, bool))
   predicted = predict(torch.as_tensor(refined._action, dtype=torch.float32), None, None, 1)
   assert np.linalg.norm(predicted[1, :3].numpy() - goal[0]) < 1e-3 * ARM_LENGTH
 
 
 def test_refinement_never_raises_the_models_error_and_keeps_inactive_actions_at_zero():
   predict = linear_arm(seed=3)
-  part = completion.Part((2,), 3)
+  given = trajectories.Given((3,), orientation=False)
   goal = np.array([[0.5, 0.5, -0.1]])  # Out of reach: the error stays, but must not grow.
   active = np.array([True, True, False, False])
   found = completer(predict=predict)
-  complete(found, goal, part, active=active)
+  complete(found, goal, given, active=active)
   refined = found._action
   assert np.all(refined[~active] == 0.0) and np.all(np.abs(refined) <= 1.0)
   nearest = completer(predict=predict)
-  complete(nearest, goal, part, refine=False, active=active)
+  complete(nearest, goal, given, refine=False, active=active)
   start = torch.as_tensor(nearest._action * active, dtype=torch.float32)
   error = lambda action: np.linalg.norm(
     predict(torch.as_tensor(action, dtype=torch.float32), None, None, 1)[2, :3].numpy() - goal[0]
@@ -117,7 +120,7 @@ def test_refinement_never_raises_the_models_error_and_keeps_inactive_actions_at_
 
 
 def test_a_still_goal_is_corrected_by_the_integrated_measured_error():
-  part = completion.Part((1,), 3)
+  given = trajectories.Given((2,), orientation=False)
   goal = np.array([[0.05, 0.0, -0.2]])
   found = completer()
   measured = np.zeros((MODULES, 6))
@@ -125,17 +128,17 @@ def test_a_still_goal_is_corrected_by_the_integrated_measured_error():
   hold_steps = int(np.ceil(completion.HOLD_SECONDS / TIMESTEP))
   gain = TIMESTEP / completion.CORRECTION_TIME_CONSTANT_S
   for step in range(hold_steps + 3):
-    target = complete(found, goal, part, refine=False, poses=measured)
+    target = complete(found, goal, given, refine=False, poses=measured)
     corrections = max(0, step - hold_steps + 1)
     np.testing.assert_allclose(target[1, :3], goal[0] + [0.01 * gain * corrections, 0, 0])
   # A new goal starts without correction; the correction is bounded.
   np.testing.assert_array_equal(
-    complete(found, goal + 0.01, part, refine=False)[1, :3], goal[0] + 0.01
+    complete(found, goal + 0.01, given, refine=False)[1, :3], goal[0] + 0.01
   )
   far = np.zeros((MODULES, 6))
   far[1, :3] = goal[0] - [10.0, 0, 0]
   for _ in range(hold_steps + 50):
-    target = complete(found, goal, part, refine=False, poses=far)
+    target = complete(found, goal, given, refine=False, poses=far)
   limit = completion.MAX_CORRECTION_ARM_LENGTHS * ARM_LENGTH
   assert np.linalg.norm(target[1, :3] - goal[0]) == pytest.approx(limit)
 
@@ -164,11 +167,11 @@ def test_a_masked_custom_run_is_completed_and_the_record_says_how(tmp_path, babb
 
 
 def test_without_measured_feedback_a_still_goal_is_not_corrected():
-  part = completion.Part((1,), 3)
+  given = trajectories.Given((2,), orientation=False)
   goal = np.array([[0.05, 0.0, -0.2]])
   found = completer()
   measured = np.zeros((MODULES, 6))
   measured[1, :3] = goal[0] - [0.01, 0.0, 0.0]
   for _ in range(int(np.ceil(completion.HOLD_SECONDS / TIMESTEP)) + 3):
-    target = found.complete(goal, part, measured, measured, np.ones(ACTIONS, bool), False, False)
+    target = found.complete(goal, given, measured, measured, np.ones(ACTIONS, bool), False, False)
     np.testing.assert_array_equal(target[1, :3], goal[0])

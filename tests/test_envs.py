@@ -30,9 +30,7 @@ def short(task: str) -> dict:
   return suite.length_options(task, SHORT_STEPS)
 
 
-FAMILY_ROBOTS = {family.benchmark[min(1, len(family.benchmark) - 1)] for family in robots.FAMILIES}
-"""One robot of each family: its second benchmark robot (two modules on a numbered family, so that
-the observation's layout has more than one module), or its only one."""
+FAMILY_ROBOTS = {family.example for family in robots.FAMILIES}
 FAMILY_PAIRS = tuple((robot, task) for robot, task in suite.ALL_TASKS if robot in FAMILY_ROBOTS)
 
 

@@ -103,10 +103,6 @@ def name_of(record: dict) -> str:
   return "-".join(record[field] for field in ("agent", "robot", "task", "profile", "eval_mode"))
 
 
-def names_of(paths) -> set[str]:
-  return {name_of(json.loads(path.read_text())) for path in paths}
-
-
 def assert_records_as_run(results: pathlib.Path, grid: sweep.Grid, expected: dict) -> None:
   """``results`` holds one record of each setting of ``grid``, equal to ``softbench run``'s but
   for ``VARYING``."""
@@ -116,14 +112,6 @@ def assert_records_as_run(results: pathlib.Path, grid: sweep.Grid, expected: dic
     assert {key: value for key, value in record.items() if key not in VARYING} == {
       key: value for key, value in expected[name_of(record)].items() if key not in VARYING
     }, name_of(record)
-
-
-def test_a_sweep_writes_the_records_softbench_run_writes(address, expected, tmp_path):
-  outcome = run_sweep(GRID, tmp_path / "results", address)
-  assert len(outcome.written) == 4 and outcome.skipped == ()
-  assert_records_as_run(tmp_path / "results", GRID, expected)
-  assert not ray.is_initialized()  # The sweep left the cluster.
-  assert not list(storage.softbench_home().glob("runs/*"))  # No kept episodes: records are in.
 
 
 @contextlib.contextmanager
@@ -159,19 +147,11 @@ def test_a_worker_killed_mid_task_is_retried_to_the_same_records(address, expect
   assert_records_as_run(tmp_path / "results", one_agent, expected)
 
 
-def test_settings_with_a_record_are_skipped(address, expected, tmp_path):
-  results, left_out, recorded = tmp_path / "results", "zero-tendon-1-reach-tiny-physics", []
-  for name, record in expected.items():
-    if name != left_out:
-      recorded.append(run.record_path(record, results))
-      records.write(record, recorded[-1])
-  outcome = run_sweep(GRID, results, address)
-  assert sorted(outcome.skipped) == sorted(recorded)
-  assert names_of(outcome.written) == {left_out}
-  assert run_sweep(GRID, results, address).written == ()  # Nothing left: Ray is not started.
-
-
-def test_an_interrupted_sweep_resumes(address, expected, tmp_path, monkeypatch):
+def test_an_interrupted_sweep_resumes_to_the_records_softbench_run_writes(
+  address, expected, tmp_path, monkeypatch
+):
+  # One test for three properties, since each needs whole sweeps on the cluster: the records
+  # equal softbench run's, an interrupted sweep resumes, and settings with a record are skipped.
   results, settings = tmp_path / "results", len(GRID.settings())
   update = display.Display.update
 
@@ -191,6 +171,9 @@ def test_an_interrupted_sweep_resumes(address, expected, tmp_path, monkeypatch):
   assert sorted(resumed.skipped) == first
   assert len(resumed.written) == settings - len(first)
   assert_records_as_run(results, GRID, expected)
+  assert not ray.is_initialized()  # The sweep left the cluster.
+  assert not list(storage.softbench_home().glob("runs/*"))  # No kept episodes: records are in.
+  assert run_sweep(GRID, results, address).written == ()  # Nothing left: Ray is not started.
 
 
 @pytest.mark.parametrize(

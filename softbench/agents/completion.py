@@ -26,7 +26,6 @@ model predicts they will be carried.
 """
 
 from collections.abc import Callable
-from collections.abc import Sequence
 import dataclasses
 
 import numpy as np
@@ -35,6 +34,7 @@ import torch
 
 from softbench.data import dataset
 from softbench.data import splits
+from softbench.suite import trajectories
 
 HOLD_SECONDS = 2.0  # (s) How long the refinement holds an action, and how long a still goal waits
 # before its correction starts; longer than every benchmark robot's settling time (tendon-5
@@ -49,7 +49,6 @@ DAMPING_TRIES = 4
 CORRECTION_TIME_CONSTANT_S = 2.0  # (s) Of the integral correction of a still goal.
 MAX_CORRECTION_ARM_LENGTHS = 0.25  # Largest correction of one module's goal position.
 POSITION = slice(0, 3)
-DEBUG = True
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -76,19 +75,6 @@ class Candidates:
     )
 
 
-@dataclasses.dataclass(frozen=True)
-class Part:
-  """The given part of a target: which modules (0-based, in the goal's order) and how many of
-  each one's six entries (3: position only, 6: position and orientation vector)."""
-
-  modules: tuple[int, ...]
-  size: int
-
-  def of(self, poses: np.ndarray) -> np.ndarray:
-    """The given entries of poses (..., num_modules, 6): (..., modules, size)."""
-    return poses[..., list(self.modules), : self.size]
-
-
 class Completer:
   """Completes partial targets for one agent, one episode at a time (module docstring).
 
@@ -110,7 +96,7 @@ class Completer:
   ):
     self._make_candidates = candidates
     self._candidates = None
-    self._trees: dict[Part, spatial.cKDTree] = {}
+    self._trees: dict[trajectories.Given, spatial.cKDTree] = {}
     self._predict = predict
     self._arm_length = arm_length
     self._hold_steps = max(1, int(np.ceil(HOLD_SECONDS / control_timestep)))
@@ -129,25 +115,25 @@ class Completer:
   def complete(
     self,
     goal: np.ndarray,
-    part: Part,
+    given: trajectories.Given,
     previous_poses: np.ndarray,
     poses: np.ndarray,
     active_actions: np.ndarray,
     refine: bool = True,
     correct: bool = True,
   ) -> np.ndarray:
-    """The whole-arm target (num_modules, 6) for ``goal`` (len(part.modules), part.size), the
+    """The whole-arm target (num_modules, 6) for ``goal`` (len(given.modules), given.size), the
     arm now at ``poses`` after ``previous_poses``; entries of the action outside
     ``active_actions`` (a boolean mask) stay zero. ``correct``: whether a still goal is corrected
     from the measured error (stage 3; not when the agent acts without measured feedback)."""
     goal = np.asarray(goal, dtype=float)
     if self._goal is None or not np.array_equal(goal, self._goal):
       self._goal, self._still_steps = goal.copy(), 0
-      self._correction = np.zeros((len(part.modules), 3))
+      self._correction = np.zeros((len(given.modules), 3))
     else:
       self._still_steps += 1
     if correct and self._still_steps >= self._hold_steps:
-      error = goal[:, POSITION] - part.of(poses)[:, POSITION]
+      error = goal[:, POSITION] - given.part(poses)[:, POSITION]
       self._correction = _clip_norms(
         self._correction + self._gain * error, MAX_CORRECTION_ARM_LENGTHS * self._arm_length
       )
@@ -155,11 +141,11 @@ class Completer:
     corrected[:, POSITION] += self._correction
     new_goal = self._still_steps == 0
     if new_goal or not refine:
-      self._pose, self._action = self._nearest(corrected, part)
+      self._pose, self._action = self._nearest(corrected, given)
     mask_changed = self._active is None or not np.array_equal(active_actions, self._active)
     if refine and (new_goal or mask_changed or self._still_steps % self._hold_steps == 0):
       steps = REFINEMENT_STEPS if new_goal else WARM_REFINEMENT_STEPS
-      self._action = self._refine(corrected, part, previous_poses, poses, active_actions, steps)
+      self._action = self._refine(corrected, given, previous_poses, poses, active_actions, steps)
       with torch.no_grad():
         pose = self._predict(
           torch.as_tensor(self._action, dtype=torch.float32),
@@ -173,28 +159,28 @@ class Completer:
       )
     self._active = np.array(active_actions, dtype=bool)
     target = np.array(self._pose, dtype=float)
-    target[list(part.modules), : part.size] = corrected
+    target[given.indices, : given.size] = corrected
     return target
 
-  def _nearest(self, goal: np.ndarray, part: Part) -> tuple[np.ndarray, np.ndarray]:
+  def _nearest(self, goal: np.ndarray, given: trajectories.Given) -> tuple[np.ndarray, np.ndarray]:
     """The candidate pose whose given part lies nearest ``goal``, and its action."""
     if self._candidates is None:
       self._candidates = self._make_candidates()
-    if part not in self._trees:
-      self._trees[part] = spatial.cKDTree(self._search_keys(part.of(self._candidates.poses)))
-    _, index = self._trees[part].query(self._search_keys(goal[None])[0])
+    if given not in self._trees:
+      self._trees[given] = spatial.cKDTree(self._search_keys(given.part(self._candidates.poses)))
+    _, index = self._trees[given].query(self._search_keys(goal[None])[0])
     return self._candidates.poses[index].copy(), self._candidates.actions[index].copy()
 
-  def _search_keys(self, given: np.ndarray) -> np.ndarray:
+  def _search_keys(self, parts: np.ndarray) -> np.ndarray:
     """Given parts (n, modules, size) as k-d tree points: positions in arm lengths."""
-    scaled = np.array(given, dtype=float)
+    scaled = np.array(parts, dtype=float)
     scaled[..., POSITION] /= self._arm_length
     return scaled.reshape(len(scaled), -1)
 
   def _refine(
     self,
     goal: np.ndarray,
-    part: Part,
+    given: trajectories.Given,
     previous_poses: np.ndarray,
     poses: np.ndarray,
     active_actions: np.ndarray,
@@ -202,13 +188,13 @@ class Completer:
   ) -> np.ndarray:
     """The action after ``steps`` damped Gauss-Newton steps from the last one."""
     active = torch.as_tensor(active_actions, dtype=torch.float32)
-    scale = torch.ones(part.size, dtype=torch.float32)
+    scale = torch.ones(given.size, dtype=torch.float32)
     scale[POSITION] = 1.0 / self._arm_length
     wanted = torch.as_tensor(goal, dtype=torch.float32) * scale
 
     def residual(action: torch.Tensor) -> torch.Tensor:
       predicted = self._predict(action * active, previous_poses, poses, self._hold_steps)
-      return (predicted[list(part.modules), : part.size] * scale - wanted).reshape(-1)
+      return (predicted[given.indices, : given.size] * scale - wanted).reshape(-1)
 
     action = torch.as_tensor(self._action, dtype=torch.float32) * active
     damping = INITIAL_DAMPING
@@ -234,8 +220,3 @@ def _clip_norms(vectors: np.ndarray, limit: float) -> np.ndarray:
   """``vectors`` (n, 3), each scaled down to at most ``limit`` long."""
   norms = np.linalg.norm(vectors, axis=-1, keepdims=True)
   return vectors * np.minimum(1.0, limit / np.maximum(norms, 1e-12))
-
-
-def given_part(scored_modules: Sequence[int], size: int) -> Part:
-  """The part of the target that a task with these 0-based scored modules and target size gives."""
-  return Part(tuple(int(module) for module in scored_modules), int(size))

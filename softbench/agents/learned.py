@@ -66,6 +66,7 @@ from softbench.records.fields import ERROR_SOURCES
 from softbench.records.fields import HELPER_TARGETS
 from softbench.robots import base as robot_base
 from softbench.robots import recorder
+from softbench.suite import trajectories
 
 DEFAULT_HELPER_TARGETS = "complete"
 CHECKPOINT_FOLDER = "checkpoints"
@@ -179,7 +180,10 @@ class LearnedAgent(base.Agent):
       active_actions = np.repeat(self._module_active(), self.robot.actuators_per_module)
       return self._completer.complete(
         target,
-        completion.given_part(self._scored, target.shape[1]),
+        trajectories.Given(
+          tuple(int(module) + 1 for module in self._scored),
+          target.shape[1] == recorder.POSE_SIZE,
+        ),
         self._previous_poses,
         poses,
         active_actions,

@@ -48,6 +48,12 @@ class Family:
     """A regular expression of the names the family answers (as records hold them)."""
     return f"{self.name}-[1-9][0-9]*" if self.numbered else self.name
 
+  @property
+  def example(self) -> str:
+    """A small robot that shows the family's layout: its second benchmark robot (two modules on a
+    numbered family, so that observations hold more than one module), or its only one."""
+    return self.benchmark[min(1, len(self.benchmark) - 1)]
+
   def answers(self, name: str) -> bool:
     return name.startswith(f"{self.name}-") if self.numbered else name == self.name
 

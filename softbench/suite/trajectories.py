@@ -96,10 +96,14 @@ class Given:
     """The text form, as ``parse`` reads it."""
     return _join(self.modules) + ("" if self.orientation else POSITION_SUFFIX)
 
+  @property
+  def indices(self) -> list[int]:
+    """The given modules' 0-based indices."""
+    return [module - 1 for module in self.modules]
+
   def part(self, poses: np.ndarray) -> np.ndarray:
     """The given entries of whole poses (..., num_modules, 6): (..., len(modules), size)."""
-    poses = np.asarray(poses)
-    return poses[..., np.array(self.modules) - 1, : self.size]
+    return np.asarray(poses)[..., self.indices, : self.size]
 
 
 def _check_module(module: int, robot: base.SoftArm) -> None:
