@@ -24,17 +24,15 @@ bench: $(STAMP)
 models: $(STAMP)
 	$(VENV)/bin/softbench models export --measure-speed
 
-# Every agent on every task of the leaderboard's robots as one sweep on Ray (softbench sweep; each
-# dataset, forward model and agent built once), then Exp1S on each tendon family, then the pages.
-# PROFILE=paper (default) is the paper's budget: hours per agent on a laptop CPU. A setting that
-# already has a record of this profile in leaderboard/results is skipped, and work under way
-# resumes from the cached datasets, checkpoints, training snapshots and finished seeds, so an
-# interrupted fill goes on where it stopped; the pages show the newest record of each setting.
-# ADDRESS=HOST:PORT runs the sweep on that Ray cluster (docs/sweep.md); WORKERS=N: processes per
-# Exp1S run (softbench run --workers; empty: one per core).
+# Every agent on every task of the leaderboard's robots, and Exp1S on each tendon family, as one
+# sweep on Ray (softbench sweep; each dataset, forward model, agent and Exp1S network built once),
+# then the pages. PROFILE=paper (default) is the paper's budget: hours per agent on a laptop CPU.
+# A setting that already has a record of this profile in leaderboard/results is skipped, and work
+# under way resumes from the cached datasets, checkpoints, training snapshots and finished seeds,
+# so an interrupted fill goes on where it stopped; the pages show the newest record of each
+# setting. ADDRESS=HOST:PORT runs the sweep on that Ray cluster (docs/sweep.md).
 PROFILE ?= paper
 ADDRESS ?=
-WORKERS ?=
 RESULTS := leaderboard/results
 # The grid comes from the library (softbench.leaderboard.grid), once softbench is installed.
 LEADERBOARD_ROBOTS = $(shell $(VENV)/bin/softbench leaderboard --grid robots)
@@ -43,13 +41,6 @@ LEADERBOARD_AGENTS = $(shell $(VENV)/bin/softbench leaderboard --grid agents)
 EXP1S_FAMILIES = $(shell $(VENV)/bin/softbench leaderboard --grid families)
 leaderboard: $(STAMP)
 	$(VENV)/bin/softbench sweep --robots $(LEADERBOARD_ROBOTS) --tasks $(LEADERBOARD_TASKS) \
-	  --agents $(LEADERBOARD_AGENTS) --profile $(PROFILE) $(if $(ADDRESS),--address $(ADDRESS)) \
-	  --results $(RESULTS)
-	set -e; for family in $(EXP1S_FAMILIES); do \
-	  named=$$([ $$family = tendon ] || echo "$$family-"); \
-	  if ls $(RESULTS)/smpl-exp1s-$${named}$(PROFILE)-*.json >/dev/null 2>&1; then \
-	    echo "skipped exp1s on $$family: it has a $(PROFILE) record"; continue; fi; \
-	  $(VENV)/bin/softbench run --protocol exp1s --family $$family --agent smpl \
-	    --profile $(PROFILE) $(if $(WORKERS),--workers $(WORKERS)) --results $(RESULTS); \
-	done
+	  --agents $(LEADERBOARD_AGENTS) --protocol exp1s --families $(EXP1S_FAMILIES) \
+	  --profile $(PROFILE) $(if $(ADDRESS),--address $(ADDRESS)) --results $(RESULTS)
 	$(VENV)/bin/softbench leaderboard --results $(RESULTS) --write

@@ -236,6 +236,10 @@ def _check_record_arguments(args: argparse.Namespace) -> None:
 
 
 def _sweep(args: argparse.Namespace) -> None:
+  if args.protocol is None and args.families is not None:
+    raise ValueError(f"--families goes with --protocol {continual.PROTOCOL}")
+  if args.protocol is not None:
+    continual.settings(args.protocol, "smpl")  # An unknown protocol: its one line.
   sweep.sweep(
     args.robots,
     args.tasks,
@@ -246,6 +250,7 @@ def _sweep(args: argparse.Namespace) -> None:
     args.eval,
     args.address,
     args.data_home,
+    families=(args.families or [continual.DEFAULT_FAMILY]) if args.protocol else (),
   )
 
 
@@ -474,20 +479,33 @@ def build_parser() -> argparse.ArgumentParser:
   run_parser.set_defaults(run=_run)
   sweep_parser = commands.add_parser(
     "sweep",
-    help="run a grid of robots, tasks and agents as Ray tasks, here or on a Ray cluster",
-    description="Runs every setting (robot, task, agent, eval mode) that --results has no "
-    "record of for the profile, as Ray tasks: each babbling dataset, forward model and agent "
-    "is built once and shared, and each record is the one softbench run writes. Without "
-    "--address, on a local Ray with one worker per core; docs/sweep.md for a cluster.",
+    help="run a grid of robots, tasks and agents (and Exp1S) as Ray tasks, here or on a cluster",
+    description="Runs every setting (robot, task, agent, eval mode; with --protocol exp1s, "
+    "Exp1S on each of --families) that --results has no record of for the profile, as Ray "
+    "tasks: each babbling dataset, forward model, agent and Exp1S network is built once and "
+    "shared, and each record is the one softbench run writes. Without --address, on a local "
+    "Ray with one worker per core; docs/sweep.md for a cluster.",
   )
   sweep_parser.add_argument(
-    "--robots", nargs="+", required=True, metavar="ROBOT", help="e.g. tendon-1 tendon-3"
+    "--robots", nargs="+", default=[], metavar="ROBOT", help="e.g. tendon-1 tendon-3"
   )
   sweep_parser.add_argument(
-    "--tasks", nargs="+", required=True, metavar="TASK", help=f"of {', '.join(suite.TASKS)}"
+    "--tasks", nargs="+", default=[], metavar="TASK", help=f"of {', '.join(suite.TASKS)}"
   )
   sweep_parser.add_argument(
-    "--agents", nargs="+", required=True, metavar="AGENT", help=f"of {', '.join(agents.AGENTS)}"
+    "--agents", nargs="+", default=[], metavar="AGENT", help=f"of {', '.join(agents.AGENTS)}"
+  )
+  sweep_parser.add_argument(
+    "--protocol",
+    help=f"{continual.PROTOCOL}: also SMPL's Exp1S on each of --families (then --robots, "
+    "--tasks and --agents may be left out)",
+  )
+  sweep_parser.add_argument(
+    "--families",
+    nargs="+",
+    metavar="FAMILY",
+    help=f"with --protocol {continual.PROTOCOL}: of {', '.join(robots.TENDON_FAMILIES)} "
+    f"(default {continual.DEFAULT_FAMILY})",
   )
   _add_profile_argument(sweep_parser)
   sweep_parser.add_argument("--seeds", type=int, help="number of seeds (default: the profile's)")

@@ -289,8 +289,7 @@ def run_seed(
   """``score_seed``, or the scores an interrupted run of the same settings and code kept: the
   seed's, or those of each episode it had finished."""
   folder = finished_seeds_folder(profile, family)
-  path, subject = folder / f"seed{seed}.json", f"seed {seed}"
-  scores = episode_snapshots.load_scores(path, subject)
+  scores = kept_scores(RunSettings(profile, family), seed)
   if scores is None:
     episodes = folder / EPISODES_FOLDER
     kept = len(list(episodes.glob(f"seed{seed}-*.json")))
@@ -302,8 +301,24 @@ def run_seed(
         file=sys.stderr,
       )
     scores = score_seed(seed, profile, show_progress, episodes, family)
-    episode_snapshots.save_scores(path, scores, subject)
+    keep_scores(RunSettings(profile, family), seed, scores)
   return scores
+
+
+def _kept_seed_file(run: RunSettings, seed: int) -> tuple[pathlib.Path, str]:
+  return finished_seeds_folder(run.profile, run.family) / f"seed{seed}.json", f"seed {seed}"
+
+
+def kept_scores(run: RunSettings, seed: int) -> dict | None:
+  """The scores of ``seed`` that an interrupted run of ``run``'s settings and code kept; None
+  if there are none (or they are damaged: reported on one line)."""
+  return episode_snapshots.load_scores(*_kept_seed_file(run, seed))
+
+
+def keep_scores(run: RunSettings, seed: int, scores: dict) -> None:
+  """Keeps the scores of ``seed`` until the record of ``run`` is written (``finish``)."""
+  path, subject = _kept_seed_file(run, seed)
+  episode_snapshots.save_scores(path, scores, subject)
 
 
 def score_seed(
@@ -387,20 +402,31 @@ def execute(
   )
   if not keep_seeds:
     episode_snapshots.discard_folder(finished_seeds_folder(profile, family))
+  return assemble_record(
+    RunSettings(profile, family, seeds), origin, per_seed, taken, time.perf_counter() - started
+  )
+
+
+def assemble_record(
+  run: RunSettings, origin: dict, per_seed: list[dict], taken: list[str], wall_time_s: float
+) -> dict:
+  """The Exp1S record of ``run`` (its ``seeds`` given): provenance ``origin``
+  (``records.provenance``), every seed's scores (``score_seed``, seed order), the zoo files
+  ``taken`` for its networks and ``wall_time_s``."""
   return {
     "format": RECORD_FORMAT,
     "version": RECORD_VERSION,
     **origin,
     "protocol": PROTOCOL,
     "agent": "smpl",
-    "robots": list(sequence.robot_names),
+    "robots": list(protocol(run.family).robot_names),
     "tasks": list(TASKS),
-    "profile": profile.name,
-    "profile_settings": dataclasses.asdict(profile),
-    "seeds": seeds,
+    "profile": run.profile.name,
+    "profile_settings": dataclasses.asdict(run.profile),
+    "seeds": run.seeds,
     "per_seed": per_seed,
     **zoo.section(taken),
-    "wall_time_s": round(time.perf_counter() - started, 3),
+    "wall_time_s": round(wall_time_s, 3),
   }
 
 

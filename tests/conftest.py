@@ -1,13 +1,13 @@
 """Fixtures shared by the test files."""
 
 import contextlib
-import dataclasses
 import os
 import shutil
 import subprocess
 import sys
 
 import pytest
+import two_stage_exp1s
 
 from smpl import snapshots
 from smpl import training
@@ -95,11 +95,9 @@ def interrupted_training(monkeypatch):
 @pytest.fixture
 def two_stages(monkeypatch, tmp_path):
   """Exp1S on tendon-1 then tendon-2 instead of tendon-1 .. 5, in a fresh data home; the stages."""
-  stages = ("tendon-1", "tendon-2")
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / "home"))
-  short = dataclasses.replace(protocols.PROTOCOLS[continual.PROTOCOL], robot_names=stages)
-  monkeypatch.setitem(protocols.PROTOCOLS, continual.PROTOCOL, short)
-  return stages
+  monkeypatch.setitem(protocols.PROTOCOLS, continual.PROTOCOL, two_stage_exp1s.shortened())
+  return two_stage_exp1s.STAGES
 
 
 @pytest.fixture

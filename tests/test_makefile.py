@@ -1,5 +1,5 @@
-"""``make leaderboard``: one sweep over the grid (the sweep skips the settings that have a record:
-test_sweep), then Exp1S per tendon family unless it has a record, then the pages."""
+"""``make leaderboard``: one sweep over the grid and Exp1S on every tendon family (the sweep skips
+the settings that have a record: test_sweep), then the pages."""
 
 import os
 import pathlib
@@ -63,22 +63,17 @@ def _fill(checkout: pathlib.Path) -> list[str]:
   return (checkout / ".venv" / "bin" / "calls.txt").read_text().splitlines()
 
 
-def test_the_fill_sweeps_every_agent_on_every_task_then_exp1s_then_the_pages(checkout):
+def test_the_fill_sweeps_every_agent_on_every_task_and_exp1s_then_the_pages(checkout):
   calls = _fill(checkout)
   axes = grid.lists()
   assert set(axes["agents"]) == set(agents.AGENTS)
-  (sweep,) = [call for call in calls if call.startswith("sweep")]
-  assert sweep == (
+  assert set(axes["families"]) == set(robots.TENDON_FAMILIES)
+  assert calls == [
     f"sweep --robots {' '.join(axes['robots'])} --tasks {' '.join(axes['tasks'])} "
-    f"--agents {' '.join(axes['agents'])} --profile paper --results leaderboard/results"
-  )
-  exp1s = [call for call in calls if "--protocol exp1s" in call]
-  assert exp1s == [
-    f"run --protocol exp1s --family {family} --agent smpl --profile paper "
-    f"--results leaderboard/results"
-    for family in robots.TENDON_FAMILIES
+    f"--agents {' '.join(axes['agents'])} --protocol exp1s --families "
+    f"{' '.join(axes['families'])} --profile paper --results leaderboard/results",
+    "leaderboard --results leaderboard/results --write",
   ]
-  assert calls == [sweep, *exp1s, "leaderboard --results leaderboard/results --write"]
 
 
 def test_the_fill_sweeps_on_a_cluster_when_given_its_address(checkout):
@@ -91,21 +86,6 @@ def test_the_fill_sweeps_on_a_cluster_when_given_its_address(checkout):
   )
   calls = (checkout / ".venv" / "bin" / "calls.txt").read_text().splitlines()
   assert "--address 10.0.0.1:6379" in calls[0] and calls[0].startswith("sweep")
-
-
-def test_an_interrupted_fill_skips_the_exp1s_families_that_have_records(checkout):
-  results = checkout / "leaderboard" / "results"
-  (results / "smpl-exp1s-paper-2026-11-24T000000Z.json").touch()
-  calls = _fill(checkout)
-  # The tendon family's Exp1S record does not stand for the tendon-local family's.
-  assert [call for call in calls if "exp1s" in call] == [
-    "run --protocol exp1s --family tendon-local --agent smpl --profile paper "
-    "--results leaderboard/results"
-  ]
-  assert calls[-1].startswith("leaderboard")
-  (results / "smpl-exp1s-tendon-local-paper-2026-11-24T000000Z.json").touch()
-  (checkout / ".venv" / "bin" / "calls.txt").unlink()
-  assert not any("exp1s" in call for call in _fill(checkout))
 
 
 @pytest.mark.parametrize("axis", list(grid.lists()))

@@ -1,7 +1,7 @@
 """``softbench sweep`` on a Ray cluster of two nodes on this machine (a head and one more, one core
-each): its records equal ``softbench run``'s, a worker killed mid-task is retried to the same
-records, settings with a record are skipped, an interrupted sweep resumes; bad settings and an
-address where no cluster answers are refused in one line before Ray starts."""
+each): its records equal ``softbench run``'s (Exp1S's too), a worker killed mid-task is retried
+to the same records, settings with a record are skipped, an interrupted sweep resumes; bad
+settings and an address where no cluster answers are refused in one line before Ray starts."""
 
 import contextlib
 import dataclasses
@@ -16,7 +16,12 @@ import time
 import pytest
 import ray
 from ray import cluster_utils
+import two_stage_exp1s
 
+from softbench import cli
+from softbench import continual
+from softbench import profiles
+from softbench import protocols
 from softbench import records
 from softbench import run
 from softbench import storage
@@ -95,6 +100,7 @@ def run_sweep(grid: sweep.Grid, results: pathlib.Path, address: str) -> sweep.Sw
     grid.eval_modes,
     address,
     show_progress=False,
+    families=grid.families,
   )
 
 
@@ -176,6 +182,39 @@ def test_an_interrupted_sweep_resumes_to_the_records_softbench_run_writes(
   assert run_sweep(GRID, results, address).written == ()  # Nothing left: Ray is not started.
 
 
+@contextlib.contextmanager
+def exp1s_shortened_on(address: str):
+  """Within the block, Exp1S is ``two_stage_exp1s``'s here and, through this process's Ray
+  (connected to ``address``; a sweep uses it), in every Ray worker: as the job's setup hook,
+  pickled by value (a task's own runtime environment cannot carry one)."""
+  with pytest.MonkeyPatch.context() as patch:
+    patch.setitem(protocols.PROTOCOLS, continual.PROTOCOL, two_stage_exp1s.shortened())
+    ray.cloudpickle.register_pickle_by_value(two_stage_exp1s)
+    ray.init(address=address, runtime_env={"worker_process_setup_hook": two_stage_exp1s.shorten})
+    try:
+      yield
+    finally:
+      ray.shutdown()
+      ray.cloudpickle.unregister_pickle_by_value(two_stage_exp1s)
+
+
+def test_exp1s_in_a_sweep_writes_the_record_softbench_run_writes(address, tmp_path):
+  tiny, family = profiles.get("tiny"), "tendon-local"
+  only_exp1s = sweep.Grid((), (), (), "tiny", 1, families=(family,))
+  with exp1s_shortened_on(address):
+    with pytest.MonkeyPatch.context() as patch:  # softbench run's record, in a home of its own.
+      patch.setenv(storage.HOME_VARIABLE, str(tmp_path / "run-home"))
+      expected = records.seal(continual.execute(tiny, 1, False, workers=1, family=family))
+    (path,) = run_sweep(only_exp1s, tmp_path / "results", None).written
+    assert not continual.finished_seeds_folder(tiny, family).exists()  # The record is in.
+  assert path.name.startswith(f"smpl-exp1s-{family}-tiny-")
+  assert path.with_name(f"{path.stem}-forgetting.png").stat().st_size > 0
+  assert {key: value for key, value in records.read(path).items() if key not in VARYING} == {
+    key: value for key, value in json.loads(records.dumps(expected)).items() if key not in VARYING
+  }
+  assert run_sweep(only_exp1s, tmp_path / "results", address).skipped == (path,)
+
+
 @pytest.mark.parametrize(
   "change,message",
   [
@@ -186,6 +225,8 @@ def test_an_interrupted_sweep_resumes_to_the_records_softbench_run_writes(
     ({"eval_modes": ("dream",)}, "unknown eval mode"),
     ({"seeds": 0}, "seeds must be"),
     ({"agents": ()}, "at least one of its agents"),
+    ({"families": ("pneumatic",)}, "unknown tendon family"),
+    ({"robots": (), "tasks": (), "agents": (), "families": ("tendon",), "seeds": 0}, "seeds must"),
   ],
 )
 def test_bad_settings_are_one_line_before_ray_starts(change, message, tmp_path):
@@ -200,4 +241,36 @@ def test_an_address_where_no_cluster_answers_is_one_line(tmp_path):
     run_sweep(zero, tmp_path / "results", "127.0.0.1:1")
   with pytest.raises(ValueError, match="HOST:PORT"):
     run_sweep(zero, tmp_path / "results", "head-without-port")
+  assert not ray.is_initialized()
+
+
+def test_an_exp1s_record_stands_for_its_own_family_only(tmp_path):
+  results = tmp_path / "results"
+  results.mkdir()
+  (results / "smpl-exp1s-tiny-2026-11-24T000000Z.json").touch()  # The tendon family's.
+  work = sweep_grid.plan(
+    sweep.Grid((), (), (), "tiny", 1, families=("tendon", "tendon-local")), results
+  )
+  assert work.skipped == (results / "smpl-exp1s-tiny-2026-11-24T000000Z.json",)
+  assert [sweep_grid.setting_name(run) for run in work.settings] == ["smpl-exp1s-tendon-local-tiny"]
+  (evaluation,) = work.evaluations
+  assert evaluation.agent.kind == "network"
+  assert [need.label for need in evaluation.agent.needs] == [
+    f"babbling tendon-local-{n} 200 samples" for n in range(1, 6)
+  ]
+
+
+@pytest.mark.parametrize(
+  "argv,message",
+  [
+    (["--families", "tendon"], "--families goes with --protocol exp1s"),
+    (["--protocol", "exp2s"], "unknown protocol 'exp2s'"),
+    (["--protocol", "exp1s", "--families", "pneumatic"], "unknown tendon family 'pneumatic'"),
+    (["--protocol", "exp1s", "--robots", "tendon-1"], "at least one of its tasks"),
+  ],
+)
+def test_the_cli_refuses_bad_protocol_options_in_one_line(argv, message, tmp_path, capsys):
+  assert cli.main(["sweep", *argv, "--results", str(tmp_path / "results")]) == 2
+  error = capsys.readouterr().err
+  assert message in error and error.count("\n") == 1
   assert not ray.is_initialized()

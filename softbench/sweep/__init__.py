@@ -1,6 +1,6 @@
-"""``softbench sweep``: a grid of settings (robots x tasks x agents x eval modes, one profile) run
-as Ray tasks, on this machine or a Ray cluster, with one record per setting as ``softbench run``
-writes it.
+"""``softbench sweep``: a grid of settings (robots x tasks x agents x eval modes, one profile),
+and Exp1S on tendon families, run as Ray tasks, on this machine or a Ray cluster, with one record
+per setting as ``softbench run`` writes it.
 
 The work is a graph (``grid``): each babbling dataset, forward model and agent is built once for
 the whole grid and shared by the evaluations that need it; a setting that has a record of its
@@ -67,20 +67,25 @@ def sweep(
   address: str | None = None,
   data_home: str | os.PathLike | None = None,
   show_progress: bool = True,
+  families: Sequence[str] = (),
 ) -> SweepResult:
   """Runs every setting of the grid that ``results`` has no record of, as Ray tasks: on the
   cluster at ``address`` (``HOST:PORT``), else on a local Ray with one worker per core (or the
   Ray this process already started); ``data_home`` replaces ``$SOFTBENCH_HOME`` for the driver
-  and every worker (docs/sweep.md: what to share).
+  and every worker (docs/sweep.md: what to share). ``families``: also Exp1S on each of these
+  tendon families (``softbench run --protocol exp1s --family F``); with families, the robots,
+  tasks and agents may all be empty.
 
   Raises:
-    ValueError: an unknown robot, task, agent, profile or eval mode, seeds < 1, an empty list, a
-      data home or results folder that cannot be written, or a Ray node with other source (one
-      line; all but the last before Ray starts).
+    ValueError: an unknown robot, task, agent, family, profile or eval mode, seeds < 1, an
+      empty list, a data home or results folder that cannot be written, or a Ray node with other
+      source (one line; all but the last before Ray starts).
     SweepFailed: some settings failed (one line); the others' records are written.
     KeyboardInterrupt: Ctrl-C or ``kill``; a rerun resumes.
   """
-  grid = Grid(tuple(robots), tuple(tasks), tuple(agents), profile, seeds, tuple(eval_modes))
+  grid = Grid(
+    tuple(robots), tuple(tasks), tuple(agents), profile, seeds, tuple(eval_modes), tuple(families)
+  )
   with _data_home(data_home):
     storage.check_home()
     folder = storage.check_writable(results, "results folder", folder=True)

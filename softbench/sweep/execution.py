@@ -6,7 +6,9 @@ its order and in parallel; a build the data home holds is shipped instead (``shi
 whose worker dies is run again (``cluster.MAX_RETRIES``). Each finished episode is kept at once
 (``episode_snapshots``), so an interrupted sweep resumes; once a setting's seeds are all in, its
 record (``run.assemble_record``, as ``softbench run`` makes it) is saved (``saving.save``) and
-its kept episodes go. A task's error is not retried: the settings that need it fail, and the
+its kept episodes go (an Exp1S run: ``continual.assemble_record``, its kept seeds' scores and its
+heat map of forgetting as ``softbench run --protocol exp1s`` leaves them). A task's error is not
+retried: the settings that need it fail, and the
 others go on.
 
 A record's wall time is the sweep's, from its start to that record; its provenance is the
@@ -19,6 +21,7 @@ import time
 import ray
 
 from smpl.files import first_line
+from softbench import continual
 from softbench import episode_snapshots
 from softbench import run as run_module
 from softbench import saving
@@ -87,14 +90,20 @@ def execute(
     outcomes[run][seed] = outcome
   written, failures = [], {}
 
-  def complete(run: run_module.RunSettings) -> None:
+  def complete(run: grid.Setting) -> None:
     if len(outcomes[run]) < run.seeds or run in failures:
       return
     in_order = [outcomes[run][seed] for seed in range(run.seeds)]
     wall_time_s = time.perf_counter() - started
-    record = run_module.assemble_record(run, origin, in_order, plan.taken[run], wall_time_s)
-    written.append(saving.save(run_module, record, results, None)[0])
-    episode_snapshots.discard(run)
+    if isinstance(run, continual.RunSettings):
+      record = continual.assemble_record(run, origin, in_order, plan.taken[run], wall_time_s)
+      files = saving.save(continual, record, results, None)
+      continual.finish(record, files)
+    else:
+      record = run_module.assemble_record(run, origin, in_order, plan.taken[run], wall_time_s)
+      files = saving.save(run_module, record, results, None)
+      episode_snapshots.discard(run)
+    written.append(files[0])
 
   work = _submit(plan)
   pending, finished, failed = list(work), set(plan.found), 0
@@ -118,7 +127,10 @@ def execute(
           if isinstance(task, grid.Build):
             shipping.write_missing(value)
           else:
-            episode_snapshots.save(task.run, task.seed, value[1])
+            if isinstance(task.run, continual.RunSettings):
+              continual.keep_scores(task.run, task.seed, value)
+            else:
+              episode_snapshots.save(task.run, task.seed, value[1])
             outcomes[task.run][task.seed] = value
             complete(task.run)
         running = sum(all(need in finished for need in _needs(work[ref])) for ref in pending)

@@ -9,6 +9,11 @@ eval mode; an agent trained on babbling needs the forward model of each view it 
 the agents that read that view: the baselines share the whole arm's) and the robot's babbling
 dataset, which sac trains on too. A build whose cache files the data home holds already is not
 built again: its files are shipped from here.
+
+Exp1S (``--protocol exp1s``, one run per tendon family) fits the same graph: each seed's network
+is a build that needs the babbling datasets of the family's arms, and each seed's scores
+(``continual.run_seed``) an evaluation of it; the record is the one ``softbench run --protocol
+exp1s`` writes.
 """
 
 import dataclasses
@@ -17,22 +22,27 @@ import itertools
 import pathlib
 
 from softbench import agents
+from softbench import continual
 from softbench import episodes
 from softbench import profiles
 from softbench import robots
 from softbench import run as run_module
 from softbench import storage
+from softbench import zoo
 from softbench.agents import forward_models
 from softbench.agents import learned
 from softbench.agents import learners
 from softbench.data import dataset as babbling_dataset
 
-KINDS = ("dataset", "forward", "agent")  # What a build makes, in the order they depend.
+KINDS = ("dataset", "forward", "agent", "network")  # What a build makes (network: Exp1S's).
+Setting = run_module.RunSettings | continual.RunSettings  # A task's run, or an Exp1S run.
 
 
 @dataclasses.dataclass(frozen=True)
 class Grid:
-  """The settings a sweep covers; ``seeds`` None takes the profile's."""
+  """The settings a sweep covers; ``seeds`` None takes the profile's. ``families``: the tendon
+  families to run Exp1S on (``--protocol exp1s``); a sweep of Exp1S alone has no robots, tasks
+  or agents."""
 
   robots: tuple[str, ...]
   tasks: tuple[str, ...]
@@ -40,14 +50,17 @@ class Grid:
   profile: str = profiles.DEFAULT_PROFILE
   seeds: int | None = None
   eval_modes: tuple[str, ...] = ("physics",)
+  families: tuple[str, ...] = ()
 
   def settings(self) -> list[run_module.RunSettings]:
-    """Every setting once, checked (``run.settings``), robot by robot, then task, agent, eval
-    mode.
+    """Every task's setting once, checked (``run.settings``), robot by robot, then task, agent,
+    eval mode.
 
     Raises:
       ValueError: an empty list, or a setting ``run.settings`` refuses (one line).
     """
+    if self.families and not (self.robots or self.tasks or self.agents):
+      return []  # Exp1S alone.
     for name, values in (
       ("robots", self.robots),
       ("tasks", self.tasks),
@@ -63,6 +76,20 @@ class Grid:
       )
     ]
     return list(dict.fromkeys(every))  # A name given twice is one setting.
+
+  def protocol_settings(self) -> list[continual.RunSettings]:
+    """The Exp1S run of each family once, checked (``continual.settings``), its seeds resolved.
+
+    Raises:
+      ValueError: an unknown family or profile, seeds < 1 (one line).
+    """
+    every = []
+    for family in dict.fromkeys(self.families):
+      run = continual.settings(continual.PROTOCOL, "smpl", self.profile, family, self.seeds)
+      seeds = run.profile.seeds if run.seeds is None else run.seeds
+      babbling_dataset.check_count("seeds", seeds)
+      every.append(dataclasses.replace(run, seeds=seeds))
+    return every
 
 
 @dataclasses.dataclass(frozen=True)
@@ -83,9 +110,10 @@ class Build:
 @dataclasses.dataclass(frozen=True)
 class Evaluation:
   """One seed's episode of a setting, by the agent that ``agent`` builds (None: built on the
-  spot, as an agent that does not learn is)."""
+  spot, as an agent that does not learn is); of an Exp1S run, one seed's scores, by the network
+  that ``agent`` builds."""
 
-  run: run_module.RunSettings
+  run: Setting
   seed: int
   agent: Build | None
 
@@ -101,23 +129,40 @@ class Plan:
   it needs), those of them the data home holds (shipped, not built), and the zoo files taken for
   each setting's checkpoints (``run.take_from_zoo``)."""
 
-  settings: tuple[run_module.RunSettings, ...]
+  settings: tuple[Setting, ...]
   skipped: tuple[pathlib.Path, ...]
-  resumed: dict[tuple[run_module.RunSettings, int], tuple[dict, episodes.Episode]]
+  resumed: dict[tuple[Setting, int], tuple[dict, episodes.Episode] | dict]
   evaluations: tuple[Evaluation, ...]
   builds: tuple[Build, ...]
   found: frozenset[Build]
-  taken: dict[run_module.RunSettings, list[str]]
+  taken: dict[Setting, list[str]]
 
 
-def setting_name(run: run_module.RunSettings) -> str:
-  """``agent-robot-task-profile-eval``, as its record's file name begins."""
+def setting_name(run: Setting) -> str:
+  """``agent-robot-task-profile-eval``, as its record's file name begins; of an Exp1S run,
+  ``smpl-exp1s-[family-]profile``, as its record's."""
+  if isinstance(run, continual.RunSettings):
+    return continual.record_path(_protocol_record(run), pathlib.Path()).stem[: -len("-*")]
   return f"{run.agent}-{run.robot}-{run.task}-{run.profile.name}-{run.eval_mode}"
 
 
-def existing_record(run: run_module.RunSettings, results: pathlib.Path) -> pathlib.Path | None:
-  """A record of ``run``'s setting in ``results`` (any date), named as ``run.record_path`` names
-  it; None if there is none."""
+def _protocol_record(run: continual.RunSettings) -> dict:
+  """What ``continual.record_path`` reads of a record of ``run``, of any date."""
+  robot_names = continual.protocol(run.family).robot_names
+  return {
+    "protocol": continual.PROTOCOL,
+    "robots": list(robot_names),
+    "profile": run.profile.name,
+    "date": "*",  # Any date stamp.
+  }
+
+
+def existing_record(run: Setting, results: pathlib.Path) -> pathlib.Path | None:
+  """A record of ``run``'s setting in ``results`` (any date), named as ``run.record_path`` (or
+  ``continual.record_path``) names it; None if there is none."""
+  if isinstance(run, continual.RunSettings):
+    pattern = continual.record_path(_protocol_record(run), results)
+    return next(iter(sorted(results.glob(pattern.name))), None)
   pattern = run_module.record_path(
     {
       "agent": run.agent,
@@ -198,10 +243,53 @@ def agent_build(agent: str, robot: str, seed: int, profile: profiles.Profile) ->
   )
 
 
+def network_build(run: continual.RunSettings, seed: int) -> Build:
+  """The build of an Exp1S seed's network (``continual.build``): it needs the babbling dataset
+  of each of the family's arms."""
+  arms = dict.fromkeys(arm.name for arm, _ in continual.protocol(run.family).column_views())
+  return Build(
+    "network",
+    f"network {continual.PROTOCOL} {run.family} seed {seed}",
+    (seed, run.profile, run.family),
+    (_relative(continual.checkpoint_path(seed, run.profile, run.family)),),
+    tuple(_dataset_build(arm, run.profile) for arm in arms),
+  )
+
+
 def is_found(build: Build) -> bool:
   """Whether the data home holds every cache file of ``build`` (one that names none: never)."""
   home = storage.softbench_home()
   return bool(build.files) and all((home / name).is_file() for name in build.files)
+
+
+def _zoo_key(run: Setting) -> tuple:
+  """What the checkpoints that ``run`` takes from the zoo depend on (shared by a task's runs)."""
+  if isinstance(run, continual.RunSettings):
+    return run
+  return (run.agent, run.robot, run.profile, run.seeds)
+
+
+def _take_from_zoo(run: Setting) -> list[str]:
+  """The zoo files taken for the checkpoints of ``run``'s seeds that the data home lacks."""
+  if isinstance(run, continual.RunSettings):
+    paths = [continual.checkpoint_path(seed, run.profile, run.family) for seed in range(run.seeds)]
+    return zoo.take(paths)[0]
+  return run_module.take_from_zoo(run)[0]
+
+
+def _resumed_seed(run: Setting, seed: int) -> tuple[dict, episodes.Episode] | dict | None:
+  """What an interrupted run or sweep kept of ``seed``: a task's entry and episode, an Exp1S
+  seed's scores; None if nothing."""
+  if isinstance(run, continual.RunSettings):
+    return continual.kept_scores(run, seed)
+  return run_module.resumed_seed(run, seed)
+
+
+def _seed_build(run: Setting, seed: int) -> Build | None:
+  """The build that ``seed``'s evaluation of ``run`` needs (None: none)."""
+  if isinstance(run, continual.RunSettings):
+    return network_build(run, seed)
+  return agent_build(run.agent, run.robot, seed, run.profile)
 
 
 def plan(grid: Grid, results: pathlib.Path) -> Plan:
@@ -210,24 +298,23 @@ def plan(grid: Grid, results: pathlib.Path) -> Plan:
   Raises:
     ValueError: a setting ``Grid.settings`` refuses (one line).
   """
-  pending, skipped, resumed, evaluations, taken_by_agent = [], [], {}, [], {}
-  for run in grid.settings():
+  pending, skipped, resumed, evaluations, taken, taken_by_build = [], [], {}, [], {}, {}
+  for run in [*grid.settings(), *grid.protocol_settings()]:
     existing = existing_record(run, results)
     if existing is not None:
       skipped.append(existing)
       continue
     pending.append(run)
-    agent_key = (run.agent, run.robot, run.profile, run.seeds)
-    if agent_key not in taken_by_agent:  # Before the checkpoints are looked for.
-      taken_by_agent[agent_key] = run_module.take_from_zoo(run)[0]
+    key = _zoo_key(run)
+    if key not in taken_by_build:  # Before the checkpoints are looked for.
+      taken_by_build[key] = _take_from_zoo(run)
+    taken[run] = taken_by_build[key]
     for seed in range(run.seeds):
-      outcome = run_module.resumed_seed(run, seed)
+      outcome = _resumed_seed(run, seed)
       if outcome is not None:
         resumed[run, seed] = outcome
       else:
-        evaluations.append(
-          Evaluation(run, seed, agent_build(run.agent, run.robot, seed, run.profile))
-        )
+        evaluations.append(Evaluation(run, seed, _seed_build(run, seed)))
   builds, found = {}, set()
 
   def add(build: Build) -> None:
@@ -250,5 +337,5 @@ def plan(grid: Grid, results: pathlib.Path) -> Plan:
     tuple(evaluations),
     tuple(builds),
     frozenset(found),
-    {run: taken_by_agent[run.agent, run.robot, run.profile, run.seeds] for run in pending},
+    taken,
   )

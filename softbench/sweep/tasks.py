@@ -3,7 +3,8 @@
 Each task first sets its process up as ``softbench run``'s seed workers are (one torch thread,
 ``smpl.training.CPU_THREADS``; one-line warnings) and writes the cache files of the builds it is
 given that its data home lacks (``shipping``). A build then finds or makes its cached files and
-returns them; an evaluation returns its seed's record entry and episode (``run.fresh_seed``).
+returns them; an evaluation returns its seed's record entry and episode (``run.fresh_seed``), or
+an Exp1S seed's scores (``continual.run_seed``).
 """
 
 import ray
@@ -11,6 +12,7 @@ import torch
 
 from smpl import training
 from softbench import agents
+from softbench import continual
 from softbench import data
 from softbench import episode_snapshots
 from softbench import parallel_seeds
@@ -43,7 +45,16 @@ def _build_agent(agent: str, robot: str, seed: int, profile) -> None:
   agents.make(agent, robot, seed, profile)
 
 
-BUILDERS = {"dataset": _collect, "forward": _train_forward_model, "agent": _build_agent}
+def _train_network(seed: int, profile, family: str) -> None:
+  continual.build(seed, profile, False, family)
+
+
+BUILDERS = {
+  "dataset": _collect,
+  "forward": _train_forward_model,
+  "agent": _build_agent,
+  "network": _train_network,
+}
 
 
 def build(kind: str, arguments: tuple, files: tuple[str, ...], *needed: shipping.Files):
@@ -54,10 +65,15 @@ def build(kind: str, arguments: tuple, files: tuple[str, ...], *needed: shipping
   return shipping.read(files)
 
 
-def evaluate(run: run_module.RunSettings, seed: int, *needed: shipping.Files):
-  """Seed ``seed``'s record entry and episode of ``run``, by the agent of ``needed`` if any."""
+def evaluate(
+  run: run_module.RunSettings | continual.RunSettings, seed: int, *needed: shipping.Files
+):
+  """Seed ``seed``'s record entry and episode of ``run``, by the agent of ``needed`` if any; of
+  an Exp1S run, the seed's scores, by the network of ``needed``."""
   _set_up()
   shipping.write_missing(*needed)
+  if isinstance(run, continual.RunSettings):
+    return continual.run_seed(seed, run.profile, run.family)
   return run_module.fresh_seed(run, seed)
 
 
