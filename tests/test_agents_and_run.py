@@ -48,7 +48,7 @@ def episode(agent_name, robot, task, seed=0):
 class TestEveryAgent:
   def test_actions_are_finite_in_bounds_and_the_same_for_a_seed(self, agent_name, robot, task):
     # A learned agent is made again from its cached checkpoint the second time; training itself
-    # is checked by test_training_from_scratch_is_deterministic.
+    # is checked by test_training_is_deterministic_and_its_checkpoint_round_trips.
     first, second = episode(agent_name, robot, task, 1), episode(agent_name, robot, task, 1)
     assert first.actions.shape == (EPISODE_STEPS, robots.make(robot).action_dim)
     assert np.all(np.isfinite(first.actions)) and np.all(np.abs(first.actions) <= 1.0)
@@ -56,41 +56,34 @@ class TestEveryAgent:
 
 
 @pytest.mark.parametrize("agent_name", LEARNED_AGENTS)
-def test_training_from_scratch_is_deterministic(agent_name, tmp_path, babbled_home):
-  """Two data homes, so that no model is cached (the babbling dataset is, copied: its
-  collection's determinism is test_data's): the same seed trains to the same actions, and
-  another seed to other actions."""
-
-  def actions(home, seed):
-    babbled_home(tmp_path / home)
-    return episode(agent_name, "tendon-2", "circle", seed).actions
-
-  first = actions("first", 1)
-  np.testing.assert_array_equal(actions("second", 1), first)
-  assert not np.array_equal(actions("second", 2), first)
-
-
-@pytest.mark.parametrize("agent_name", LEARNED_AGENTS)
-def test_checkpoint_round_trip_gives_identical_actions(
+def test_training_is_deterministic_and_its_checkpoint_round_trips(
   agent_name, tmp_path, babbled_home, assert_one_line_retraining
 ):
-  babbled_home(tmp_path)
-  trained = episode(agent_name, "tendon-2", "circle")  # Trains, then saves the checkpoint.
-  (checkpoint,) = (tmp_path / learned.CHECKPOINT_FOLDER).glob(f"{agent_name}-*.pt")
-  loaded = episode(agent_name, "tendon-2", "circle")
+  """Trained in one data home, then made again from its checkpoint: the same actions; a damaged
+  checkpoint is reported in one line and trained again, to the same weights. Trained from scratch
+  in a second data home (no model cached; the babbling dataset is, copied: its collection's
+  determinism is test_data's): the same seed gives the same actions, another seed others."""
+  babbled_home(tmp_path / "first")
+  trained = episode(agent_name, "tendon-2", "circle", 1)  # Trains, then saves the checkpoint.
+  (checkpoint,) = (tmp_path / "first" / learned.CHECKPOINT_FOLDER).glob(f"{agent_name}-*.pt")
+  loaded = episode(agent_name, "tendon-2", "circle", 1)
   np.testing.assert_array_equal(trained.actions, loaded.actions)
   checkpoint.write_bytes(checkpoint.read_bytes()[:1000])
-  # A damaged cached checkpoint is reported in one line and trained again, to the same weights.
   with pytest.warns(data.CorruptFileWarning) as caught:
-    retrained = episode(agent_name, "tendon-2", "circle")
+    retrained = episode(agent_name, "tendon-2", "circle", 1)
   assert_one_line_retraining(caught, checkpoint)
   np.testing.assert_array_equal(retrained.actions, trained.actions)
   with warnings.catch_warnings():
     warnings.simplefilter("error")  # Written again whole: it loads without a warning.
     np.testing.assert_array_equal(
-      episode(agent_name, "tendon-2", "circle").actions, trained.actions
+      episode(agent_name, "tendon-2", "circle", 1).actions, trained.actions
     )
   assert [path.name for path in checkpoint.parent.iterdir()] == [checkpoint.name]
+  babbled_home(tmp_path / "second")
+  np.testing.assert_array_equal(
+    episode(agent_name, "tendon-2", "circle", 1).actions, trained.actions
+  )
+  assert not np.array_equal(episode(agent_name, "tendon-2", "circle", 2).actions, trained.actions)
 
 
 @pytest.mark.parametrize("damage", ["hello", "flipped weight"])
