@@ -7,7 +7,7 @@ import subprocess
 import sys
 
 import pytest
-import two_stage_exp1s
+import worker_hooks
 
 from smpl import snapshots
 from smpl import training
@@ -96,8 +96,8 @@ def interrupted_training(monkeypatch):
 def two_stages(monkeypatch, tmp_path):
   """Exp1S on tendon-1 then tendon-2 instead of tendon-1 .. 5, in a fresh data home; the stages."""
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / "home"))
-  monkeypatch.setitem(protocols.PROTOCOLS, continual.PROTOCOL, two_stage_exp1s.shortened())
-  return two_stage_exp1s.STAGES
+  monkeypatch.setitem(protocols.PROTOCOLS, continual.PROTOCOL, worker_hooks.shortened_exp1s())
+  return worker_hooks.EXP1S_STAGES
 
 
 @pytest.fixture

@@ -16,7 +16,7 @@ import time
 import pytest
 import ray
 from ray import cluster_utils
-import two_stage_exp1s
+import worker_hooks
 
 from softbench import cli
 from softbench import continual
@@ -183,27 +183,29 @@ def test_an_interrupted_sweep_resumes_to_the_records_softbench_run_writes(
 
 
 @contextlib.contextmanager
-def exp1s_shortened_on(address: str):
-  """Within the block, Exp1S is ``two_stage_exp1s``'s here and, through this process's Ray
-  (connected to ``address``; a sweep uses it), in every Ray worker: as the job's setup hook,
-  pickled by value (a task's own runtime environment cannot carry one)."""
-  with pytest.MonkeyPatch.context() as patch:
-    patch.setitem(protocols.PROTOCOLS, continual.PROTOCOL, two_stage_exp1s.shortened())
-    ray.cloudpickle.register_pickle_by_value(two_stage_exp1s)
-    ray.init(address=address, runtime_env={"worker_process_setup_hook": two_stage_exp1s.shorten})
-    try:
-      yield
-    finally:
-      ray.shutdown()
-      ray.cloudpickle.unregister_pickle_by_value(two_stage_exp1s)
+def ray_with_worker_hook(address: str, hook):
+  """Within the block, this process's Ray (a sweep uses it) is connected to ``address`` with
+  ``hook`` (of ``worker_hooks``) as the job's setup hook, which every Ray worker runs first;
+  pickled by value, since a task's own runtime environment cannot carry one."""
+  ray.cloudpickle.register_pickle_by_value(worker_hooks)
+  ray.init(address=address, runtime_env={"worker_process_setup_hook": hook})
+  try:
+    yield
+  finally:
+    ray.shutdown()
+    ray.cloudpickle.unregister_pickle_by_value(worker_hooks)
 
 
 def test_exp1s_in_a_sweep_writes_the_record_softbench_run_writes(address, tmp_path):
   tiny, family = profiles.get("tiny"), "tendon-local"
   only_exp1s = sweep.Grid((), (), (), "tiny", 1, families=(family,))
-  with exp1s_shortened_on(address):
-    with pytest.MonkeyPatch.context() as patch:  # softbench run's record, in a home of its own.
-      patch.setenv(storage.HOME_VARIABLE, str(tmp_path / "run-home"))
+  with (
+    pytest.MonkeyPatch.context() as patch,
+    ray_with_worker_hook(address, worker_hooks.shorten_exp1s),
+  ):
+    patch.setitem(protocols.PROTOCOLS, continual.PROTOCOL, worker_hooks.shortened_exp1s())
+    with pytest.MonkeyPatch.context() as home:  # softbench run's record, in a home of its own.
+      home.setenv(storage.HOME_VARIABLE, str(tmp_path / "run-home"))
       expected = records.seal(continual.execute(tiny, 1, False, workers=1, family=family))
     (path,) = run_sweep(only_exp1s, tmp_path / "results", None).written
     assert not continual.finished_seeds_folder(tiny, family).exists()  # The record is in.
@@ -213,6 +215,23 @@ def test_exp1s_in_a_sweep_writes_the_record_softbench_run_writes(address, tmp_pa
     key: value for key, value in json.loads(records.dumps(expected)).items() if key not in VARYING
   }
   assert run_sweep(only_exp1s, tmp_path / "results", address).skipped == (path,)
+
+
+def test_a_task_that_raises_fails_its_settings_only_in_one_line_and_a_rerun_retries(
+  address, expected, tmp_path
+):
+  results, zero_and_mlp = tmp_path / "results", dataclasses.replace(GRID, tasks=("circle",))
+  with ray_with_worker_hook(address, worker_hooks.break_agent_builds):
+    with pytest.raises(sweep.SweepFailed) as raised:
+      run_sweep(zero_and_mlp, results, None)
+  assert str(raised.value).startswith("1 of 2 settings failed") and "\n" not in str(raised.value)
+  assert f"mlp-tendon-1-circle-tiny-physics: RuntimeError: {worker_hooks.BROKEN_BUILD}" in str(
+    raised.value
+  )
+  assert_records_as_run(results, dataclasses.replace(zero_and_mlp, agents=("zero",)), expected)
+  rerun = run_sweep(zero_and_mlp, results, address)
+  assert len(rerun.skipped) == 1 and len(rerun.written) == 1
+  assert_records_as_run(results, zero_and_mlp, expected)
 
 
 @pytest.mark.parametrize(
