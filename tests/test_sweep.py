@@ -145,12 +145,39 @@ def killing_the_first(title: str):
     killer.join()
 
 
-def test_a_worker_killed_mid_task_is_retried_to_the_same_records(address, expected, tmp_path):
-  one_agent = dataclasses.replace(GRID, tasks=("circle",), agents=("mlp",))
-  with killing_the_first("ray::agent mlp tendon-1 seed 1") as killed:
-    run_sweep(one_agent, tmp_path / "results", address)
+@contextlib.contextmanager
+def ray_with_worker_hook(address: str, hook):
+  """Within the block, this process's Ray (a sweep uses it) is connected to ``address`` with
+  ``hook`` (of ``worker_hooks``) as the job's setup hook, which every Ray worker runs first;
+  pickled by value, since a task's own runtime environment cannot carry one."""
+  ray.cloudpickle.register_pickle_by_value(worker_hooks)
+  ray.init(address=address, runtime_env={"worker_process_setup_hook": hook})
+  try:
+    yield
+  finally:
+    ray.shutdown()
+    ray.cloudpickle.unregister_pickle_by_value(worker_hooks)
+
+
+def test_a_killed_worker_is_retried_and_a_task_that_raises_fails_only_its_setting(
+  address, expected, tmp_path
+):
+  # One sweep for both faults: mlp's agent build is killed once, every zero evaluation raises.
+  results, mlp_and_zero = tmp_path / "results", dataclasses.replace(GRID, tasks=("circle",))
+  with (
+    ray_with_worker_hook(address, worker_hooks.break_zero_evaluations),
+    killing_the_first("ray::agent mlp tendon-1 seed 1") as killed,
+    pytest.raises(sweep.SweepFailed) as raised,
+  ):
+    run_sweep(mlp_and_zero, results, None)
   assert len(killed) == 1
-  assert_records_as_run(tmp_path / "results", one_agent, expected)
+  message = str(raised.value)
+  assert message.startswith("1 of 2 settings failed") and "\n" not in message
+  assert f"zero-tendon-1-circle-tiny-physics: RuntimeError: {worker_hooks.BROKEN}" in message
+  assert_records_as_run(results, dataclasses.replace(mlp_and_zero, agents=("mlp",)), expected)
+  rerun = run_sweep(mlp_and_zero, results, address)  # Retries the failed setting.
+  assert len(rerun.skipped) == 1 and len(rerun.written) == 1
+  assert_records_as_run(results, mlp_and_zero, expected)
 
 
 def test_an_interrupted_sweep_resumes_to_the_records_softbench_run_writes(
@@ -182,20 +209,6 @@ def test_an_interrupted_sweep_resumes_to_the_records_softbench_run_writes(
   assert run_sweep(GRID, results, address).written == ()  # Nothing left: Ray is not started.
 
 
-@contextlib.contextmanager
-def ray_with_worker_hook(address: str, hook):
-  """Within the block, this process's Ray (a sweep uses it) is connected to ``address`` with
-  ``hook`` (of ``worker_hooks``) as the job's setup hook, which every Ray worker runs first;
-  pickled by value, since a task's own runtime environment cannot carry one."""
-  ray.cloudpickle.register_pickle_by_value(worker_hooks)
-  ray.init(address=address, runtime_env={"worker_process_setup_hook": hook})
-  try:
-    yield
-  finally:
-    ray.shutdown()
-    ray.cloudpickle.unregister_pickle_by_value(worker_hooks)
-
-
 def test_exp1s_in_a_sweep_writes_the_record_softbench_run_writes(address, tmp_path):
   tiny, family = profiles.get("tiny"), "tendon-local"
   only_exp1s = sweep.Grid((), (), (), "tiny", 1, families=(family,))
@@ -215,23 +228,6 @@ def test_exp1s_in_a_sweep_writes_the_record_softbench_run_writes(address, tmp_pa
     key: value for key, value in json.loads(records.dumps(expected)).items() if key not in VARYING
   }
   assert run_sweep(only_exp1s, tmp_path / "results", address).skipped == (path,)
-
-
-def test_a_task_that_raises_fails_its_settings_only_in_one_line_and_a_rerun_retries(
-  address, expected, tmp_path
-):
-  results, zero_and_mlp = tmp_path / "results", dataclasses.replace(GRID, tasks=("circle",))
-  with ray_with_worker_hook(address, worker_hooks.break_agent_builds):
-    with pytest.raises(sweep.SweepFailed) as raised:
-      run_sweep(zero_and_mlp, results, None)
-  assert str(raised.value).startswith("1 of 2 settings failed") and "\n" not in str(raised.value)
-  assert f"mlp-tendon-1-circle-tiny-physics: RuntimeError: {worker_hooks.BROKEN_BUILD}" in str(
-    raised.value
-  )
-  assert_records_as_run(results, dataclasses.replace(zero_and_mlp, agents=("zero",)), expected)
-  rerun = run_sweep(zero_and_mlp, results, address)
-  assert len(rerun.skipped) == 1 and len(rerun.written) == 1
-  assert_records_as_run(results, zero_and_mlp, expected)
 
 
 @pytest.mark.parametrize(

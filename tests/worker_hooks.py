@@ -1,14 +1,15 @@
 """Changes that tests make in their own process and, as a Ray job's setup hook, in every Ray
-worker of a sweep (``test_sweep``): Exp1S shortened to two arms, or agent builds that fail."""
+worker of a sweep (``test_sweep``): Exp1S shortened to two arms, or the zero agent's evaluations
+failing."""
 
 import dataclasses
 
 from softbench import continual
 from softbench import protocols
-from softbench.sweep import tasks
+from softbench import run
 
 EXP1S_STAGES = ("tendon-1", "tendon-2")  # Exp1S on these arms (of whichever family), not 1 .. 5.
-BROKEN_BUILD = "an agent build broken on purpose"  # The error of ``break_agent_builds``.
+BROKEN = "an evaluation broken on purpose"  # The error of ``break_zero_evaluations``.
 
 
 def shortened_exp1s() -> protocols.Protocol:
@@ -19,9 +20,13 @@ def shorten_exp1s() -> None:
   protocols.PROTOCOLS[continual.PROTOCOL] = shortened_exp1s()
 
 
-def _broken_build(*arguments) -> None:
-  raise RuntimeError(BROKEN_BUILD)
+def break_zero_evaluations() -> None:
+  """Every seed of the zero agent raises (``run.fresh_seed``, which a sweep's evaluation calls)."""
+  fresh_seed = run.fresh_seed
 
+  def broken_for_zero(settings: run.RunSettings, seed: int, show_progress: bool = False):
+    if settings.agent == "zero":
+      raise RuntimeError(BROKEN)
+    return fresh_seed(settings, seed, show_progress)
 
-def break_agent_builds() -> None:
-  tasks.BUILDERS["agent"] = _broken_build
+  run.fresh_seed = broken_for_zero
