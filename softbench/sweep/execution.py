@@ -8,8 +8,7 @@ whose worker dies is run again (``cluster.MAX_RETRIES``). Each finished episode 
 record (``run.assemble_record``, as ``softbench run`` makes it) is saved (``saving.save``) and
 its kept episodes go (an Exp1S run: ``continual.assemble_record``, its kept seeds' scores and its
 heat map of forgetting as ``softbench run --protocol exp1s`` leaves them). A task's error is not
-retried: the settings that need it fail, and the
-others go on.
+retried: the settings that need it fail, and the others go on.
 
 A record's wall time is the sweep's, from its start to that record; its provenance is the
 driver's, taken at the start, with the device the workers trained on.
