@@ -85,13 +85,13 @@ def settings(
   eval_mode: str = "physics",
   task_options: Sequence[str] = (),
 ) -> RunSettings:
-  """Checked settings of ``softbench run --protocol``: Exp1S fixes its robots, tasks and loops,
-  so it takes agent smpl, the physics eval mode and none of a task run's options
-  (``task_options``: the flags given, e.g. ``--task``).
+  """Checked settings of ``softbench run --protocol``, its seeds resolved (None: the profile's):
+  Exp1S fixes its robots, tasks and loops, so it takes agent smpl, the physics eval mode and none
+  of a task run's options (``task_options``: the flags given, e.g. ``--task``).
 
   Raises:
     ValueError: another protocol or agent, a task run's option, another eval mode, an unknown
-      profile or family (one line).
+      profile or family, fewer than one seed (one line).
   """
   if protocol_name != PROTOCOL:
     raise ValueError(
@@ -112,7 +112,18 @@ def settings(
   chosen = profiles.get(profile)
   family = family or DEFAULT_FAMILY
   protocol(family)
-  return RunSettings(chosen, family, seeds)
+  return RunSettings(chosen, family, seed_count(chosen, seeds))
+
+
+def seed_count(profile: profiles.Profile, seeds: int | None) -> int:
+  """``seeds``, or the profile's if None.
+
+  Raises:
+    ValueError: fewer than one seed (one line).
+  """
+  seeds = profile.seeds if seeds is None else seeds
+  dataset.check_count("seeds", seeds)
+  return seeds
 
 
 @dataclasses.dataclass(frozen=True)
@@ -389,8 +400,7 @@ def execute(
   once the record is safely written)."""
   started = time.perf_counter()
   origin = provenance.provenance(str(learned.training.default_device()))
-  seeds = profile.seeds if seeds is None else seeds
-  dataset.check_count("seeds", seeds)
+  seeds = seed_count(profile, seeds)
   sequence = protocol(family)
   taken, trained = zoo.take([checkpoint_path(seed, profile, family) for seed in range(seeds)])
   for arm, _ in [] if trained else sequence.column_views():  # Every core, before the seeds.
@@ -512,16 +522,15 @@ def finish(record: dict, files: list[pathlib.Path]) -> None:
   print(f"plot: {heat_map}")
 
 
-def record_path(record: dict, results: pathlib.Path) -> pathlib.Path:
-  """``smpl-exp1s-PROFILE-DATE.json`` on the default family, ``smpl-exp1s-FAMILY-PROFILE-DATE``
-  on another."""
-  family = family_of(record)
-  name = "-".join(
-    [
-      f"smpl-{record['protocol']}",
-      *([family] if family != DEFAULT_FAMILY else []),
-      record["profile"],
-      provenance.date_stamp(record),
-    ]
+def run_name(profile_name: str, family: str) -> str:
+  """``smpl-exp1s-PROFILE`` on the default family, ``smpl-exp1s-FAMILY-PROFILE`` on another: how
+  the file names of its records begin."""
+  return "-".join(
+    [f"smpl-{PROTOCOL}", *([family] if family != DEFAULT_FAMILY else []), profile_name]
   )
-  return results / f"{name}.json"
+
+
+def record_path(record: dict, results: pathlib.Path) -> pathlib.Path:
+  """``run_name``, then the record's date: ``smpl-exp1s-[FAMILY-]PROFILE-DATE.json``."""
+  name = run_name(record["profile"], family_of(record))
+  return results / f"{name}-{provenance.date_stamp(record)}.json"

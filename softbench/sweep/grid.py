@@ -83,13 +83,10 @@ class Grid:
     Raises:
       ValueError: an unknown family or profile, seeds < 1 (one line).
     """
-    every = []
-    for family in dict.fromkeys(self.families):
-      run = continual.settings(continual.PROTOCOL, "smpl", self.profile, family, self.seeds)
-      seeds = run.profile.seeds if run.seeds is None else run.seeds
-      babbling_dataset.check_count("seeds", seeds)
-      every.append(dataclasses.replace(run, seeds=seeds))
-    return every
+    return [
+      continual.settings(continual.PROTOCOL, "smpl", self.profile, family, self.seeds)
+      for family in dict.fromkeys(self.families)
+    ]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -142,27 +139,15 @@ def setting_name(run: Setting) -> str:
   """``agent-robot-task-profile-eval``, as its record's file name begins; of an Exp1S run,
   ``smpl-exp1s-[family-]profile``, as its record's."""
   if isinstance(run, continual.RunSettings):
-    return continual.record_path(_protocol_record(run), pathlib.Path()).stem[: -len("-*")]
+    return continual.run_name(run.profile.name, run.family)
   return f"{run.agent}-{run.robot}-{run.task}-{run.profile.name}-{run.eval_mode}"
-
-
-def _protocol_record(run: continual.RunSettings) -> dict:
-  """What ``continual.record_path`` reads of a record of ``run``, of any date."""
-  robot_names = continual.protocol(run.family).robot_names
-  return {
-    "protocol": continual.PROTOCOL,
-    "robots": list(robot_names),
-    "profile": run.profile.name,
-    "date": "*",  # Any date stamp.
-  }
 
 
 def existing_record(run: Setting, results: pathlib.Path) -> pathlib.Path | None:
   """A record of ``run``'s setting in ``results`` (any date), named as ``run.record_path`` (or
   ``continual.record_path``) names it; None if there is none."""
   if isinstance(run, continual.RunSettings):
-    pattern = continual.record_path(_protocol_record(run), results)
-    return next(iter(sorted(results.glob(pattern.name))), None)
+    return next(iter(sorted(results.glob(f"{setting_name(run)}-*.json"))), None)
   pattern = run_module.record_path(
     {
       "agent": run.agent,
