@@ -139,19 +139,6 @@ def test_reference_agent_does_not_depend_on_the_thread_count():
   np.testing.assert_array_equal(single.actions, several.actions)
 
 
-def test_reference_agent_forgets_its_restart_memory_between_episodes():
-  # Babbling restarts at almost every step, from remembered actions after the first restart.
-  def babbling_actions(agent, env_seed):
-    env = suite.load("tendon-3", "babbling", seed=env_seed, length=BABBLING_LENGTH)
-    return run_episode(agent, env, "babbling", BABBLING_STEPS).actions
-
-  used = agents.make("reference", "tendon-3")
-  babbling_actions(used, env_seed=1)
-  np.testing.assert_array_equal(
-    babbling_actions(used, env_seed=0), babbling_actions(agents.make("reference", "tendon-3"), 0)
-  )
-
-
 @pytest.mark.parametrize(
   "robot,task,options",
   [
@@ -179,39 +166,44 @@ import sys
 import numpy as np
 import test_agents_model_based as tests
 from softbench import agents, suite
-env = suite.load("tendon-3", "babbling", seed=0, length=tests.BABBLING_LENGTH)
-episode = tests.run_episode(agents.make("reference", "tendon-3"), env, "babbling",
-                            tests.BABBLING_STEPS)
-np.save(sys.argv[1], episode.actions)
+agent = agents.make("reference", "tendon-3")
+for env_seed in map(int, sys.argv[2:]):  # The last episode's actions are saved.
+  env = suite.load("tendon-3", "babbling", seed=env_seed, length=tests.BABBLING_LENGTH)
+  actions = tests.run_episode(agent, env, "babbling", tests.BABBLING_STEPS).actions
+np.save(sys.argv[1], actions)
 """
+X86_64 = platform.machine().lower() in ("x86_64", "amd64")
 
 
-@pytest.mark.skipif(
-  platform.machine().lower() not in ("x86_64", "amd64"), reason="OpenBLAS's x86-64 kernels"
-)
-def test_reference_actions_do_not_depend_on_the_cpus_blas_kernels(tmp_path):
-  # numpy's OpenBLAS picks its kernels by CPU; with numpy's algebra, the first babbling restart
-  # (step 3) stalled 9 to 46 mm off with the AVX-512 kernels, 6 to 31 mm with the SSE ones and
-  # converged with the AVX2 ones, and step 1's actions already differed by 2e-15.
-  actions = {}
-  for kernel in ("Nehalem", None):  # SSE4.2, which every x86-64 CPU of the last 15 years has;
-    # then the machine's own (the same on an SSE-only CPU, which makes the test vacuous there).
+def test_reference_babbling_depends_on_neither_the_blas_kernels_nor_an_earlier_episode(tmp_path):
+  """A fresh agent with SSE4.2 kernels (which every x86-64 CPU of the last 15 years has) acts
+  as an agent with the machine's own kernels that babbled another episode first.
+
+  numpy's OpenBLAS picks its kernels by CPU; with numpy's algebra, the first babbling restart
+  (step 3) stalled 9 to 46 mm off with the AVX-512 kernels, 6 to 31 mm with the SSE ones and
+  converged with the AVX2 ones, and step 1's actions already differed by 2e-15 (the kernels are
+  the same on an SSE-only CPU or off x86-64, where this checks the episodes alone). Babbling
+  restarts at almost every step, from remembered actions after the first restart: the memory
+  is the episode's own."""
+
+  def babbling_actions(kernel: str | None, env_seeds: list[int]) -> np.ndarray:
     environment = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
     environment.pop("OPENBLAS_CORETYPE", None)
     if kernel:
       environment["OPENBLAS_CORETYPE"] = kernel
-    path = tmp_path / f"{kernel}.npy"
+    environment["PYTHONPATH"] = os.pathsep.join(
+      [str(pathlib.Path(__file__).parent), environment.get("PYTHONPATH", "")]
+    )
+    path = tmp_path / f"{kernel}-{len(env_seeds)}.npy"
     subprocess.run(
-      [sys.executable, "-c", _BABBLING_ACTIONS_PROGRAM, str(path)],
+      [sys.executable, "-c", _BABBLING_ACTIONS_PROGRAM, str(path), *map(str, env_seeds)],
       check=True,
-      env={
-        **environment,
-        "PYTHONPATH": os.pathsep.join(
-          [str(pathlib.Path(__file__).parent), environment.get("PYTHONPATH", "")]
-        ),
-      },
+      env=environment,
       timeout=300,
     )
-    actions[kernel] = np.load(path)
-  assert actions["Nehalem"].shape == (BABBLING_STEPS, robots.make("tendon-3").action_dim)
-  np.testing.assert_array_equal(actions["Nehalem"], actions[None])
+    return np.load(path)
+
+  fresh = babbling_actions("Nehalem" if X86_64 else None, env_seeds=[0])
+  used = babbling_actions(None, env_seeds=[1, 0])
+  assert fresh.shape == (BABBLING_STEPS, robots.make("tendon-3").action_dim)
+  np.testing.assert_array_equal(fresh, used)

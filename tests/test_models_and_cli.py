@@ -32,8 +32,9 @@ def test_committed_models_are_identical_to_regenerated(name):
 
 
 # Measuring a README's figures takes seconds to minutes per robot (the discretisation check
-# simulates a 4x finer arm); the two smallest robots show that the measurements reproduce.
-@pytest.mark.parametrize("name", ["tendon-1", "tendon-2"])
+# simulates a 4x finer arm); the smallest robot of each tendon family shows that the
+# measurements reproduce (tendon-2 took 4 times tendon-1's 4 s).
+@pytest.mark.parametrize("name", ["tendon-1", "tendon-local-1"])
 def test_committed_model_readme_is_identical_to_regenerated(name):
   speed = json.loads((MODELS / name / export.SPEED_FILE).read_text())
   assert (MODELS / name / "README.md").read_text() == export.readme(robots.make(name), speed)
