@@ -1,6 +1,7 @@
 """Seeds in worker processes (``softbench.run``): results in order, errors raised, a dead worker
 reported instead of a hang, Ctrl-C or kill stopping every worker."""
 
+import multiprocessing
 import os
 import select
 import signal
@@ -116,27 +117,30 @@ def test_ctrl_c_or_kill_stops_every_worker(stop):
   assert "children left: 0" in out
 
 
-_COMPILING_PROGRAM = """
+_SEMAPHORE_PROGRAM = """
 import sys
 sys.path.insert(0, {tests!r})
 from softbench import parallel_seeds
 import test_parallel_seeds
-print(parallel_seeds.in_processes(test_parallel_seeds.compiled_double, [(1.0,), (2.0,)],
-                                  "compiling", workers=1))
+print(parallel_seeds.in_processes(test_parallel_seeds.doubled_holding_a_semaphore,
+                                  [(1.0,), (2.0,)], "holding", workers=1))
 """
+_HELD_SEMAPHORES = []
 
 
-def compiled_double(value):
-  import torch  # Only the workers pay for it.
-
-  return float(torch.compile(lambda tensor: 2 * tensor)(torch.tensor(value)))
+def doubled_holding_a_semaphore(value):
+  """``2 * value``; the worker keeps a named semaphore, as torch.compile's worker pools do."""
+  if not _HELD_SEMAPHORES:
+    _HELD_SEMAPHORES.append(multiprocessing.get_context("spawn").Semaphore())
+  return 2 * value
 
 
 def test_finished_workers_exit_cleanly():
   # Terminating idle workers left torch.compile's pool semaphores to the resource tracker, which
   # warned "There appear to be 2 leaked semaphore objects" after every compiled training run. One
-  # worker (idle once both values are done) shows it, at half the compiling of two.
-  program = _COMPILING_PROGRAM.format(tests=os.path.dirname(__file__))
+  # worker (idle once both values are done) that holds a semaphore shows it (terminated, it
+  # leaves "1 leaked semaphore objects", measured).
+  program = _SEMAPHORE_PROGRAM.format(tests=os.path.dirname(__file__))
   result = subprocess.run(
     [sys.executable, "-c", program], capture_output=True, text=True, timeout=300
   )

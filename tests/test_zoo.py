@@ -132,12 +132,19 @@ def test_a_tampered_zoo_file_is_refused_in_one_line_and_the_agent_trained(
     '{"format": "other", "version": 1, "entries": []}',
   ],
 )
-def test_a_damaged_manifest_is_one_warning_and_the_agent_trains(
-  damage, zoo_of, tmp_path, monkeypatch
+def test_a_damaged_manifest_is_refused_in_one_line(damage, tmp_path):
+  (tmp_path / zoo.MANIFEST).write_text(damage)
+  with pytest.raises(ValueError, match="unreadable zoo manifest") as raised:
+    zoo.read_manifest(tmp_path)
+  assert str(tmp_path / zoo.MANIFEST) in str(raised.value) and "\n" not in str(raised.value)
+
+
+def test_an_unreadable_manifest_is_one_warning_and_the_agent_trains(
+  zoo_of, babbled, tmp_path, monkeypatch
 ):
   folder, trained = zoo_of("mlp")
-  (folder / zoo.MANIFEST).write_text(damage)
-  use(monkeypatch, tmp_path / "empty", folder)
+  (folder / zoo.MANIFEST).write_text("not json")
+  use(monkeypatch, tmp_path / "empty", folder, datasets=babbled)
   with pytest.warns(zoo.ZooWarning, match="unreadable zoo manifest"):
     np.testing.assert_array_equal(actions("mlp"), trained)
 
