@@ -93,9 +93,11 @@ def interrupted_training(monkeypatch):
 
 
 @pytest.fixture
-def two_stages(monkeypatch, tmp_path):
-  """Exp1S on tendon-1 then tendon-2 instead of tendon-1 .. 5, in a fresh data home; the stages."""
-  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / "home"))
+def two_stages(monkeypatch, tmp_path, babbled_home):
+  """Exp1S on tendon-1 then tendon-2 instead of tendon-1 .. 5, in a fresh data home that holds
+  their tiny babbling datasets (``babbled_home``); the stages."""
+  for robot in worker_hooks.EXP1S_STAGES:
+    babbled_home(tmp_path / "home", robot)
   monkeypatch.setitem(protocols.PROTOCOLS, continual.PROTOCOL, worker_hooks.shortened_exp1s())
   return worker_hooks.EXP1S_STAGES
 
