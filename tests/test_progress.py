@@ -1,0 +1,36 @@
+"""Progress bars on an output that is not a terminal (a log file), where rich draws nothing until
+the work ends: each bar writes a line of its state at most every ``progress.LOG_INTERVAL_S``."""
+
+import re
+
+from softbench import progress
+
+
+def _state_lines(output: str) -> list[str]:
+  return [line for line in output.splitlines() if line.endswith(" elapsed")]
+
+
+def test_a_bar_writes_its_state_to_a_log_at_most_every_interval(capsys, monkeypatch):
+  monkeypatch.setattr(progress, "LOG_INTERVAL_S", 0.0)  # Every change is due.
+  with progress.counting() as bars:
+    bar = bars.add_task("seeds", total=5)
+    bars.update(bar, completed=1)
+    bars.advance(bar)
+  lines = _state_lines(capsys.readouterr().out)
+  assert len(lines) == 2
+  for line, done in zip(lines, (1, 2)):
+    assert re.fullmatch(rf"seeds: {done}/5, \d+:\d\d:\d\d elapsed", line), line
+  monkeypatch.setattr(progress, "LOG_INTERVAL_S", 3600.0)
+  with progress.counting() as bars:
+    bar = bars.add_task("seeds", total=5)
+    bars.update(bar, completed=1)
+    bars.advance(bar)
+  out = capsys.readouterr().out
+  assert _state_lines(out) == [] and "2/5" in out  # Only rich's last frame.
+
+
+def test_a_hidden_bar_writes_nothing(capsys, monkeypatch):
+  monkeypatch.setattr(progress, "LOG_INTERVAL_S", 0.0)
+  with progress.counting(show=False) as bars:
+    bars.update(bars.add_task("seeds", total=5), completed=1)
+  assert capsys.readouterr().out == ""
