@@ -17,8 +17,8 @@ from softbench import parallel_seeds
 CHILD_DEADLINE_S = 60  # (s) A child program still running after this has hung.
 
 
-def square(value):
-  return value * value
+def square_and_torch_threads(value):
+  return value * value, torch.get_num_threads()
 
 
 def fail(value):
@@ -29,23 +29,17 @@ def die(value):
   os._exit(3)
 
 
-def test_results_come_back_in_order():
-  assert parallel_seeds.in_processes(square, [(3,), (1,), (2,)], "squares", workers=2) == [9, 1, 4]
-
-
-def torch_threads(_):
-  return torch.get_num_threads()
-
-
-def test_every_seed_runs_one_torch_thread():
+def test_results_come_back_in_order_from_workers_of_one_torch_thread():
   # Torch's default is one thread per core in every worker, which oversubscribes the cores.
-  assert parallel_seeds.in_processes(torch_threads, [(0,), (1,)], "threads", workers=2) == [1, 1]
+  assert parallel_seeds.in_processes(
+    square_and_torch_threads, [(3,), (1,), (2,)], "squares", workers=2
+  ) == [(9, 1), (1, 1), (4, 1)]
   before = torch.get_num_threads()
   torch.set_num_threads(2)
   try:  # In this process (one worker), for the seeds only.
     assert parallel_seeds.over_seeds(
-      lambda seed, show: torch_threads(seed), 2, (), "threads", False, workers=1
-    ) == [1, 1]
+      lambda seed, show: square_and_torch_threads(seed), 2, (), "threads", False, workers=1
+    ) == [(0, 1), (1, 1)]
     assert torch.get_num_threads() == 2
   finally:
     torch.set_num_threads(before)
