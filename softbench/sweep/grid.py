@@ -144,23 +144,9 @@ def setting_name(run: Setting) -> str:
 
 
 def existing_record(run: Setting, results: pathlib.Path) -> pathlib.Path | None:
-  """A record of ``run``'s setting in ``results`` (any date), named as ``run.record_path`` (or
-  ``continual.record_path``) names it; None if there is none."""
-  if isinstance(run, continual.RunSettings):
-    return next(iter(sorted(results.glob(f"{setting_name(run)}-*.json"))), None)
-  pattern = run_module.record_path(
-    {
-      "agent": run.agent,
-      "robot": run.robot,
-      "task": run.task,
-      "profile": run.profile.name,
-      "eval_mode": run.eval_mode,
-      "faults": [],
-      "date": "*",  # Any date stamp.
-    },
-    results,
-  )
-  return next(iter(sorted(results.glob(pattern.name))), None)
+  """A record of ``run``'s setting in ``results`` (any date): a file named ``setting_name``, then
+  a date, as ``run.record_path`` (or ``continual.record_path``) names it; None if there is none."""
+  return next(iter(sorted(results.glob(f"{setting_name(run)}-*.json"))), None)
 
 
 def _relative(path: pathlib.Path) -> str:
