@@ -137,6 +137,16 @@ def test_bend_amplitude_bends_the_end_effector_by_the_stated_angle(robot):
   assert abs(bend - references.BEND_DEG) < 3.0
 
 
+@pytest.mark.parametrize("cores", [1, 3])
+def test_bend_amplitude_stops_early_at_the_answer_of_the_whole_grid(cores, monkeypatch):
+  arm = robots.make("tendon-2")  # Reaches BEND_DEG at the 7th of 20 grid points.
+  calibrate = references.bend_amplitude.__wrapped__  # Past the cache.
+  monkeypatch.setattr(references.os, "cpu_count", lambda: len(references.AMPLITUDE_GRID))
+  whole_grid = calibrate(arm)  # One batch: every actuation held.
+  monkeypatch.setattr(references.os, "cpu_count", lambda: cores)
+  assert calibrate(arm) == whole_grid
+
+
 def test_reference_shapes_differ_and_stay_in_unit_actuation():
   arm = robots.make("pneumatic-433")
   actions = {

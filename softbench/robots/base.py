@@ -8,6 +8,7 @@ the robot (``softbench.robots.physics.SoftArmPhysics`` reads it back).
 
 import abc
 import dataclasses
+import functools
 import math
 
 import mujoco
@@ -16,6 +17,7 @@ import numpy as np
 from softbench.robots import faults as fault_model
 
 ACTION_MAP_NAME = "action_map"
+XML_CACHE_SIZE = 16  # Robots whose MJCF each process keeps (under 0.5 MB each up to 10 modules).
 MODULE_LENGTH_RANGE = (0.005, 1.0)  # (m) Module lengths an arm accepts: a typo such as 80 for
 # 80 mm, or 1e-6, is refused rather than built (MuJoCo fails below about 1e-5 m).
 
@@ -165,9 +167,9 @@ class SoftArm(abc.ABC):
     return spec
 
   def to_xml(self) -> str:
-    spec = self.build_spec()
-    spec.compile()
-    return spec.to_xml()
+    """The robot's MJCF, generated once per process for equal robots (frozen specs): every
+    environment, reference and cache key asks for it, and generating it takes 10 to 200 ms."""
+    return _generated_xml(self)
 
   def compile(self) -> mujoco.MjModel:
     """The model exactly as its exported MJCF loads (the XML rounds numbers to 6 digits, so
@@ -179,6 +181,13 @@ class SoftArm(abc.ABC):
     model = model if model is not None else self.compile()
     base_body = model.body("base").id
     return float(model.body_subtreemass[base_body] - model.body_mass[base_body])
+
+
+@functools.lru_cache(maxsize=XML_CACHE_SIZE)
+def _generated_xml(robot: SoftArm) -> str:
+  spec = robot.build_spec()
+  spec.compile()
+  return spec.to_xml()
 
 
 def check_positive(name: str, value: float) -> None:
