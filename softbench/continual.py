@@ -35,7 +35,6 @@ from softbench import episodes
 from softbench import evaluation
 from softbench import metrics
 from softbench import parallel_seeds
-from softbench import plots
 from softbench import profiles
 from softbench import protocols
 from softbench import robots
@@ -513,6 +512,8 @@ def finish(record: dict, files: list[pathlib.Path]) -> None:
   """What follows a saved record (``files``, the results folder's first): the finished seeds
   kept for resuming go (only now: a failed write leaves a run that resumes), then the heat map
   of forgetting beside the record."""
+  from softbench import plots  # Not at the top: as in run.finish, no seed worker needs it.
+
   profile, family = profiles.get(record["profile"]), family_of(record)
   episode_snapshots.discard_folder(finished_seeds_folder(profile, family))
   path = files[0]

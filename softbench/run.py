@@ -25,14 +25,12 @@ from softbench import episodes
 from softbench import evaluation
 from softbench import metrics
 from softbench import parallel_seeds
-from softbench import plots
 from softbench import profiles
 from softbench import records
 from softbench import robots
 from softbench import saving
 from softbench import suite
 from softbench import zoo
-from softbench.adaptive import plot as adaptive_plot
 from softbench.agents import learned
 from softbench.data import dataset
 from softbench.records import provenance
@@ -234,6 +232,10 @@ def finish(
   """What follows a saved record (``files``, the results folder's first): the finished seeds
   kept for resuming go (only now: a failed write leaves a run that resumes), then the plots,
   then the video, which the record files then link."""
+  # Plotting imports matplotlib (0.7 s), which no seed worker or Ray task needs: not at the top.
+  from softbench import plots
+  from softbench.adaptive import plot as adaptive_plot
+
   episode_snapshots.discard(run)
   if run.adaptive:
     print(f"plot: {adaptive_plot.write(record, files[0].with_suffix('.png'))}")

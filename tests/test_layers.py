@@ -1,6 +1,7 @@
 """The package's layers import one way: no cycle among softbench's units (its subpackages and
 top-level modules), counting every import statement, deferred ones too; and the agent registry,
-the records, the leaderboard and the listings of the command line import without torch."""
+the records, the leaderboard and the listings of the command line import without torch, and what
+seed workers import without matplotlib."""
 
 import ast
 import pathlib
@@ -27,8 +28,13 @@ def _imported(path: pathlib.Path, module: str) -> set[str]:
   """Every module named by an import statement of ``path`` (module ``module``), relative ones
   resolved; ``from a import b`` names both ``a`` and ``a.b``."""
   package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+  return _names_imported(ast.parse(path.read_text(), str(path)), package)
+
+
+def _names_imported(tree: ast.AST, package: str) -> set[str]:
+  """Every module named by an import statement within ``tree``, of a module of ``package``."""
   names = set()
-  for node in ast.walk(ast.parse(path.read_text(), str(path))):
+  for node in ast.walk(tree):
     if isinstance(node, ast.Import):
       names.update(alias.name for alias in node.names)
     elif isinstance(node, ast.ImportFrom):
@@ -111,3 +117,50 @@ def test_the_registries_and_the_records_import_without_torch(modules):
   code = f"import sys, {modules}; print('torch' in sys.modules)"
   result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
   assert result.stdout.strip() == "False"
+
+
+def _module_file(module: str) -> pathlib.Path | None:
+  """The source file of softbench module ``module``, or None for another package's."""
+  parts = module.split(".")
+  if parts[0] != "softbench":
+    return None
+  base = PACKAGE.parent.joinpath(*parts)
+  for path in (base / "__init__.py", base.with_suffix(".py")):
+    if path.is_file():
+      return path
+  return None
+
+
+def _loaded_with(module: str) -> set[str]:
+  """Every module that importing ``module`` loads through softbench's own module-level import
+  statements (not those deferred into functions), its packages' ``__init__`` included."""
+  loaded, pending = set(), [module]
+  while pending:
+    name = pending.pop()
+    parts = name.split(".")
+    for prefix in (".".join(parts[:end]) for end in range(1, len(parts) + 1)):
+      if prefix in loaded:
+        continue
+      loaded.add(prefix)
+      path = _module_file(prefix)
+      if path is not None:
+        top_level = ast.Module(
+          body=[node for node in ast.parse(path.read_text()).body if not _is_definition(node)],
+          type_ignores=[],
+        )
+        package = prefix if path.name == "__init__.py" else prefix.rpartition(".")[0]
+        pending.extend(_names_imported(top_level, package))
+  return loaded
+
+
+def _is_definition(node: ast.stmt) -> bool:
+  return isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef))
+
+
+def test_seed_workers_and_sweep_tasks_load_no_plotting():
+  # Each seed worker and Ray task imports these in a fresh process; matplotlib took 0.7 s of it.
+  for module in ("softbench.run", "softbench.continual", "softbench.sweep.tasks"):
+    loaded = _loaded_with(module)
+    assert {"softbench.run", "softbench.agents", "torch"} & loaded, module  # The walk works.
+    plotting = sorted(name for name in loaded if name.split(".")[0] == "matplotlib")
+    assert not plotting, f"{module} loads {plotting}"
