@@ -366,11 +366,12 @@ TENDON_3 = Setting("tendon-3")
 LOCAL_3 = Setting("tendon-local-3")
 PNEUMATIC = Setting("pneumatic-433")
 TENDON_3_PAPER = Setting("tendon-3", "paper")
+LOCAL_3_PAPER = Setting("tendon-local-3", "paper")
 PNEUMATIC_PAPER = Setting("pneumatic-433", "paper")
 
 TABLES: dict[str, Callable[[ranking.Leaderboard], Table]] = {
   "headline-spiral": spiral_headline(
-    (TENDON_3, TENDON_3_PAPER, LOCAL_3, PNEUMATIC, PNEUMATIC_PAPER)
+    (TENDON_3, TENDON_3_PAPER, LOCAL_3, LOCAL_3_PAPER, PNEUMATIC, PNEUMATIC_PAPER)
   ),
   "headline-exp1s-spiral": exp1s_headline(
     (("tendon", "default"), ("tendon", "paper"), ("tendon-local", "default"))
@@ -378,16 +379,20 @@ TABLES: dict[str, Callable[[ranking.Leaderboard], Table]] = {
   "overview-tendon-3-default": overview_table(TENDON_3),
   "overview-tendon-3-paper": overview_table(TENDON_3_PAPER),
   "overview-tendon-local-3-default": overview_table(LOCAL_3),
+  "overview-tendon-local-3-paper": overview_table(LOCAL_3_PAPER),
   "overview-pneumatic-433-default": overview_table(PNEUMATIC),
   "overview-pneumatic-433-paper": overview_table(PNEUMATIC_PAPER),
   "modules-tendon-3-spiral-default": modules_table(TENDON_3, "spiral"),
   "modules-tendon-3-spiral-paper": modules_table(TENDON_3_PAPER, "spiral"),
   "modules-tendon-local-3-spiral-default": modules_table(LOCAL_3, "spiral"),
+  "modules-tendon-local-3-spiral-paper": modules_table(LOCAL_3_PAPER, "spiral"),
   "modules-pneumatic-433-spiral-default": modules_table(PNEUMATIC, "spiral"),
   "modules-pneumatic-433-spiral-paper": modules_table(PNEUMATIC_PAPER, "spiral"),
   "profiles-tendon-3": comparison_table(TENDON_3, TENDON_3_PAPER),
   "profiles-pneumatic-433": comparison_table(PNEUMATIC, PNEUMATIC_PAPER),
+  "profiles-tendon-local-3": comparison_table(LOCAL_3, LOCAL_3_PAPER),
   "plants-tendon-3-tendon-local-3": comparison_table(TENDON_3, LOCAL_3),
+  "plants-tendon-3-tendon-local-3-paper": comparison_table(TENDON_3_PAPER, LOCAL_3_PAPER),
   "eval-modes-tendon-3-spiral": eval_modes_table(
     "tendon-3", "spiral", "default", ("physics", "model", "open-loop")
   ),
