@@ -24,17 +24,13 @@ def _unit(module: str) -> str | None:
   return parts[1] if exists else None
 
 
-def _imported(path: pathlib.Path, module: str) -> set[str]:
+def _imported(path: pathlib.Path, module: str, deferred: bool = True) -> set[str]:
   """Every module named by an import statement of ``path`` (module ``module``), relative ones
-  resolved; ``from a import b`` names both ``a`` and ``a.b``."""
+  resolved; ``from a import b`` names both ``a`` and ``a.b``. Without ``deferred``, only the
+  statements run on import (none inside a function)."""
   package = module if path.name == "__init__.py" else module.rpartition(".")[0]
-  return _names_imported(ast.parse(path.read_text(), str(path)), package)
-
-
-def _names_imported(tree: ast.AST, package: str) -> set[str]:
-  """Every module named by an import statement within ``tree``, of a module of ``package``."""
   names = set()
-  for node in ast.walk(tree):
+  for node in _nodes(ast.parse(path.read_text(), str(path)), deferred):
     if isinstance(node, ast.Import):
       names.update(alias.name for alias in node.names)
     elif isinstance(node, ast.ImportFrom):
@@ -45,6 +41,22 @@ def _names_imported(tree: ast.AST, package: str) -> set[str]:
       names.add(base)
       names.update(f"{base}.{alias.name}" for alias in node.names)
   return names
+
+
+def _nodes(tree: ast.AST, deferred: bool):
+  """Every node of ``tree``; without ``deferred``, none within a function's body."""
+  if deferred:
+    yield from ast.walk(tree)
+    return
+  pending = [tree]
+  while pending:
+    node = pending.pop()
+    yield node
+    pending.extend(
+      child
+      for child in ast.iter_child_nodes(node)
+      if not isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda))
+    )
 
 
 def import_graph() -> dict[str, dict[str, list[str]]]:
@@ -144,17 +156,8 @@ def _loaded_with(module: str) -> set[str]:
       loaded.add(prefix)
       path = _module_file(prefix)
       if path is not None:
-        top_level = ast.Module(
-          body=[node for node in ast.parse(path.read_text()).body if not _is_definition(node)],
-          type_ignores=[],
-        )
-        package = prefix if path.name == "__init__.py" else prefix.rpartition(".")[0]
-        pending.extend(_names_imported(top_level, package))
+        pending.extend(_imported(path, prefix, deferred=False))
   return loaded
-
-
-def _is_definition(node: ast.stmt) -> bool:
-  return isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef))
 
 
 def test_seed_workers_and_sweep_tasks_load_no_plotting():

@@ -78,17 +78,17 @@ def bend_amplitude(robot: base.SoftArm) -> float:
   holds = int(np.ceil(SETTLE_SECONDS / robot.control_timestep))
   batch = os.cpu_count() or 1
   pose_recorder = recorder.PoseRecorder(robot, workers=batch)
-  bends = np.empty(0)
+  rest_axis = pose_recorder.poses(pose_recorder.rest_state())[-1, 3:]
+  held = []
   for start in range(0, len(AMPLITUDE_GRID), batch):
     amplitudes = AMPLITUDE_GRID[start : start + batch]
     points = np.stack([amplitudes, np.zeros_like(amplitudes)], axis=-1)
     actions = np.repeat(robot.planar_action(points)[:, None], holds, axis=1)
     poses, _ = pose_recorder.record(actions)
-    rest_axis = poses[0, 0, -1, 3:]
-    held = np.degrees(np.arccos(np.clip(poses[:, -1, -1, 3:] @ rest_axis, -1.0, 1.0)))
-    bends = np.concatenate([bends, held])
-    if np.any(held >= BEND_DEG):
+    held.extend(np.degrees(np.arccos(np.clip(poses[:, -1, -1, 3:] @ rest_axis, -1.0, 1.0))))
+    if max(held[start:]) >= BEND_DEG:
       break
+  bends = np.array(held)
   reached = np.flatnonzero(bends >= BEND_DEG)
   if len(reached) == 0:
     return 1.0
