@@ -3,6 +3,7 @@
 scores hides outside a block, and ``softbench leaderboard --write`` rewrites the blocks."""
 
 import pathlib
+import re
 import shutil
 
 import pytest
@@ -147,3 +148,20 @@ def test_another_results_folder_has_no_doc_pages(tmp_path):
   (tmp_path / "README.md").write_text(_block("no-such"))
   assert doc_tables.pages(tmp_path / "results") == []
   assert doc_tables.pages(tmp_path / "leaderboard" / "results") == [tmp_path / "README.md"]
+
+
+README_MAX_LINES = 300  # A page a user reads in about five minutes (issue 26).
+LINK = re.compile(r"\]\(<?([^)<>\s]+)>?\)")
+
+
+def test_the_readme_is_a_five_minute_read():
+  lines = (ROOT / "README.md").read_text(encoding="utf-8").count("\n")
+  assert lines <= README_MAX_LINES, f"README.md has {lines} lines; move detail to docs/"
+
+
+@pytest.mark.parametrize("page", [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))])
+def test_every_relative_link_names_a_file_of_the_checkout(page):
+  targets = [link.split("#")[0] for link in LINK.findall(page.read_text(encoding="utf-8"))]
+  local = [target for target in targets if target and "://" not in target]
+  missing = [target for target in local if not (page.parent / target).exists()]
+  assert missing == [], f"{page.name} links to files that do not exist: {missing}"
