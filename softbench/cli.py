@@ -287,8 +287,10 @@ def _zoo_add(args: argparse.Namespace) -> None:
     args.agent, args.robot, args.protocol, args.family, args.profile, args.seeds
   )
   folder = zoo.chosen_folder(args.zoo, create=True)
-  added, skipped = zoo_catalogue.add(chosen, pathlib.Path(args.results), folder)
-  print(zoo_listing.additions(added, skipped, folder))
+  added, skipped, unchecked = zoo_catalogue.add(
+    chosen, pathlib.Path(args.results), folder, args.link_unchecked
+  )
+  print(zoo_listing.additions(added, skipped, folder, unchecked))
 
 
 def _zoo_verify(args: argparse.Namespace) -> None:
@@ -645,7 +647,7 @@ def _add_zoo_parser(commands) -> None:
     help="copy a setting's trained weights (or unfinished training) into the zoo",
     description="Copies each seed's checkpoint and forward models from the data home into the "
     "zoo, or the saved state of a training still under way, and links the records "
-    "in --results that they stand behind.",
+    "in --results that they made: those whose weights section names these files' sha256.",
   )
   add_parser.add_argument("--agent", help="a learned agent")
   add_parser.add_argument("--robot", help="the robot it was trained on")
@@ -658,6 +660,12 @@ def _add_zoo_parser(commands) -> None:
   _add_profile_argument(add_parser)
   add_parser.add_argument(
     "--results", default=str(leaderboard.DEFAULT_RESULTS), help="folder of the records to link"
+  )
+  add_parser.add_argument(
+    "--link-unchecked",
+    action="store_true",
+    help="also link the setting's records that name no weights (made before records named "
+    "them); check them with softbench zoo verify",
   )
   add_parser.add_argument("--zoo", help=zoo_help)
   add_parser.set_defaults(run=_zoo_add)

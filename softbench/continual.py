@@ -421,7 +421,8 @@ def assemble_record(
 ) -> dict:
   """The Exp1S record of ``run`` (its ``seeds`` given): provenance ``origin``
   (``records.provenance``), every seed's scores (``score_seed``, seed order), the zoo files
-  ``taken`` for its networks and ``wall_time_s``."""
+  ``taken`` for its networks, the sha256 of each seed's network (``zoo.weights_section``) and
+  ``wall_time_s``."""
   return {
     "format": RECORD_FORMAT,
     "version": RECORD_VERSION,
@@ -435,6 +436,9 @@ def assemble_record(
     "seeds": run.seeds,
     "per_seed": per_seed,
     **zoo.section(taken),
+    **zoo.weights_section(
+      [[checkpoint_path(seed, run.profile, run.family)] for seed in range(run.seeds)]
+    ),
     "wall_time_s": round(wall_time_s, 3),
   }
 

@@ -356,6 +356,19 @@ def _run_seed(seed: int, run: RunSettings, show_progress: bool) -> tuple[dict, e
   return outcome
 
 
+def weight_files(run: RunSettings) -> list[list[pathlib.Path]]:
+  """Per seed, the cache files a babbling learner of ``run`` is made of (checkpoint, forward
+  models); none for the other agents."""
+  learner = agents.learner(run.agent)
+  if learner is None:
+    return []
+  arm = robots.make(run.robot)
+  return [
+    [path for path, _ in learned.cache_files(run.agent, arm, seed, run.profile, learner.per_module)]
+    for seed in range(run.seeds)
+  ]
+
+
 def take_from_zoo(run: RunSettings) -> tuple[list[str], bool]:
   """For an agent trained on babbling, the zoo files taken for the checkpoints of ``run``'s seeds
   that the data home lacks (``zoo.take``), and whether every one is now in the data home; for
@@ -432,7 +445,8 @@ def assemble_record(
   """The result record of ``run``: its provenance ``origin`` (``records.provenance``) and
   settings, every seed's entry and the scored modules from ``outcomes`` (seed order), what an
   agent that learns by acting spent on each seed's training (read from its cache), the zoo files
-  ``taken`` for it and ``wall_time_s``; for an adaptive run its ``adaptive`` section instead of
+  ``taken`` for it, the sha256 of each seed's weight files (``zoo.weights_section``) and
+  ``wall_time_s``; for an adaptive run its ``adaptive`` section instead of
   per-seed scores."""
   arm = robots.make(run.robot)
   if adaptive is not None:
@@ -466,6 +480,7 @@ def assemble_record(
     "faults": [fault_model.describe(arm, fault) for fault in run.faults],
     **results,
     **zoo.section(taken),
+    **zoo.weights_section(weight_files(run)),
     "wall_time_s": round(wall_time_s, 3),
   }
 

@@ -304,9 +304,7 @@ def test_verify_reports_a_record_the_zoo_does_not_reproduce(babbled, tmp_path, m
   )
   ((path, record),) = records.read_folder(tmp_path / "results")
   record["per_seed"][0]["mean_reward"] /= 2  # A record that these weights did not score.
-  records.write(
-    {key: value for key, value in record.items() if key != records.INTEGRITY_FIELD}, path
-  )
+  _reseal(record, path)
   capsys.readouterr()
   assert (
     cli.main(
@@ -327,6 +325,54 @@ def test_verify_reports_a_record_the_zoo_does_not_reproduce(babbled, tmp_path, m
     == cli.EXIT_USAGE
   )
   assert "sha256 differs" in capsys.readouterr().err
+
+
+def _reseal(record: dict, path) -> None:
+  records.write(
+    {key: value for key, value in record.items() if key != records.INTEGRITY_FIELD}, path
+  )
+
+
+def test_zoo_add_links_only_the_records_its_weights_made(babbled, tmp_path, monkeypatch, capsys):
+  use(monkeypatch, tmp_path / "trained", datasets=babbled)
+  assert cli.main(run_command(tmp_path / "results", seeds=1)) == 0
+  ((made, record),) = records.read_folder(tmp_path / "results")
+  chosen = catalogue.setting("lstm", ROBOT, None, "tiny", 1)
+  named = record["weights"]["per_seed"][0]["files"]
+  home = tmp_path / "trained"
+  assert named == {
+    path.relative_to(home).as_posix(): zoo.file_sha256(path)
+    for _, path, _ in catalogue.cache_files(chosen)
+  }
+  other = json.loads(json.dumps(record))  # Scored with other weights (a retrained checkpoint).
+  checkpoint = next(path for path in named if path.startswith(learned.CHECKPOINT_FOLDER))
+  other["weights"]["per_seed"][0]["files"][checkpoint] = "0" * 64
+  _reseal(other, tmp_path / "results" / made.name.replace(".json", "-other.json"))
+  older = {key: value for key, value in record.items() if key != "weights"}  # Names none.
+  _reseal(older, tmp_path / "results" / made.name.replace(".json", "-older.json"))
+  argv = [
+    *("zoo", "add", "--agent", "lstm", "--robot", ROBOT, "--profile", "tiny", "--seeds", "1"),
+    *("--results", str(tmp_path / "results")),
+  ]
+  capsys.readouterr()
+  assert cli.main([*argv, "--zoo", str(tmp_path / "zoo")]) == 0
+  (entry,) = [e for e in zoo.read_manifest(tmp_path / "zoo").values() if e.kind == "agent"]
+  assert entry.records == (made.name,)
+  out = capsys.readouterr().out
+  assert f"not linked {made.name.replace('.json', '-older.json')}: it names no weights" in out
+  assert "-other.json" not in out
+  assert cli.main([*argv, "--link-unchecked", "--zoo", str(tmp_path / "zoo-all")]) == 0
+  (entry,) = [e for e in zoo.read_manifest(tmp_path / "zoo-all").values() if e.kind == "agent"]
+  assert entry.records == tuple(sorted([made.name, made.name.replace(".json", "-older.json")]))
+
+
+def test_a_record_naming_weights_of_a_seed_it_lacks_is_refused(babbled, tmp_path, monkeypatch):
+  use(monkeypatch, tmp_path / "trained", datasets=babbled)
+  assert cli.main(run_command(tmp_path / "results", seeds=1)) == 0
+  ((path, record),) = records.read_folder(tmp_path / "results")
+  record["weights"]["per_seed"].append({**record["weights"]["per_seed"][0], "seed": 1})
+  with pytest.raises(records.RecordError, match="weights names seeds"):
+    _reseal(record, path)
 
 
 @pytest.mark.parametrize(

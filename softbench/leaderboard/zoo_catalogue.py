@@ -1,5 +1,6 @@
 """What the zoo keeps for a setting: the cache files of a learned agent's seeds (or of Exp1S's
-networks), the committed records each of them stands behind, and adding them to the zoo."""
+networks), the committed records each of them stands behind (those whose ``weights`` section
+names these files' sha256), and adding them to the zoo."""
 
 import dataclasses
 import pathlib
@@ -11,6 +12,7 @@ from softbench import records
 from softbench import robots
 from softbench import zoo
 from softbench.agents import learned
+from softbench.records import fields as record_fields
 
 
 @dataclasses.dataclass(frozen=True)
@@ -110,7 +112,7 @@ def cache_files(chosen: Setting) -> list[tuple[int, pathlib.Path, str]]:
 
 
 def stands_behind(record: dict, chosen: Setting, seed: int) -> bool:
-  """Whether ``record`` scored seed ``seed`` of ``chosen`` with its weights (healthy robot)."""
+  """Whether ``record`` is one of ``chosen``'s with a seed ``seed`` (healthy robot)."""
   if record["profile"] != chosen.profile.name or seed >= record["seeds"]:
     return False
   if chosen.family is not None:
@@ -126,24 +128,62 @@ def stands_behind(record: dict, chosen: Setting, seed: int) -> bool:
   )
 
 
-def records_of(chosen: Setting, results: pathlib.Path) -> dict[int, list[str]]:
-  """The names of the records in ``results`` that each seed's weights stand behind."""
+def made_by(record: dict, seed: int, hashes: dict[str, str]) -> bool | None:
+  """Whether ``record`` scored seed ``seed`` with the weight files of ``hashes`` (data-home path
+  -> sha256): every file its ``weights`` section names for the seed has that sha256. None when
+  the record names no weights for the seed (made before records named them): it cannot tell."""
+  named = [
+    entry["files"]
+    for entry in record.get(record_fields.WEIGHTS_FIELD, {}).get("per_seed", [])
+    if entry["seed"] == seed
+  ]
+  if not named:
+    return None
+  return all(hashes.get(path) == sha256 for path, sha256 in named[0].items())
+
+
+@dataclasses.dataclass(frozen=True)
+class Links:
+  """The records in a results folder that each seed's weights made (``linked``), and those of
+  the setting that name no weights and were not linked (``unchecked``), by file name."""
+
+  linked: dict[int, list[str]]
+  unchecked: list[str]
+
+
+def records_of(chosen: Setting, results: pathlib.Path, link_unchecked: bool = False) -> Links:
+  """The records in ``results`` that each seed's weights in the data home made; a record that
+  names no weights is linked only with ``link_unchecked``."""
   found = records.read_folder(results)
-  return {
-    seed: [path.name for path, record in found if stands_behind(record, chosen, seed)]
-    for seed in range(chosen.seeds)
-  }
+  files_of_seed: dict[int, list[pathlib.Path]] = {}
+  for seed, path, _ in cache_files(chosen):
+    files_of_seed.setdefault(seed, []).append(path)
+  linked, unchecked = {}, set()
+  for seed in range(chosen.seeds):
+    (hashes,) = zoo.weights([files_of_seed[seed]])
+    linked[seed] = []
+    for path, record in found:
+      if not stands_behind(record, chosen, seed):
+        continue
+      made = made_by(record, seed, hashes)
+      if made or (made is None and link_unchecked):
+        linked[seed].append(path.name)
+      elif made is None:
+        unchecked.add(path.name)
+  return Links(linked, sorted(unchecked))
 
 
 def add(
-  chosen: Setting, results: pathlib.Path, zoo_folder: pathlib.Path
-) -> tuple[list[zoo.Entry], list[pathlib.Path]]:
+  chosen: Setting, results: pathlib.Path, zoo_folder: pathlib.Path, link_unchecked: bool = False
+) -> tuple[list[zoo.Entry], list[pathlib.Path], list[str]]:
   """``zoo.add`` of the setting's cache files, each seed's checkpoint linked to the records in
-  ``results`` that it stands behind; returns the entries added and the cache files skipped."""
-  linked = records_of(chosen, results)
+  ``results`` that its weights made (``records_of``); returns the entries added, the cache files
+  skipped and the records not linked because they name no weights."""
+  links = records_of(chosen, results, link_unchecked)
   files = cache_files(chosen)
-  return zoo.add(
+  added, skipped = zoo.add(
     [(path, kind) for _, path, kind in files],
-    {path: linked[seed] for seed, path, kind in files if kind == "agent"},
+    {path: links.linked[seed] for seed, path, kind in files if kind == "agent"},
     zoo_folder,
   )
+  return added, skipped, links.unchecked

@@ -44,7 +44,15 @@ VERSION = 2
 INTEGRITY_FIELD = record_fields.INTEGRITY_FIELD
 """Errors a record may hold per seed; position and normalised tip error always, orientation
 except for position-only tasks (reach)."""
-_OPTIONAL_FIELDS = ("video", "faults", "zoo", "training", "helpers", "given")
+_OPTIONAL_FIELDS = (
+  "video",
+  "faults",
+  "zoo",
+  "training",
+  "helpers",
+  "given",
+  record_fields.WEIGHTS_FIELD,
+)
 ADAPTIVE_SECTION = "adaptive"  # softbench run --adaptive: per-target results, no per-seed ones.
 _MEAN_TOLERANCE = 1e-9  # Relative: a seed's mean against the mean of its per-module values.
 _MAX_MESSAGE_CHARS = 160  # Of a schema error's message, so that a refusal stays one line.
@@ -121,6 +129,8 @@ def schema() -> dict:
         "files": {"type": "array", "items": {"type": "string", "minLength": 1}, "minItems": 1}
       },
     },
+    # The files each seed's agent was made of, with their sha256 (softbench.zoo.weights_section).
+    record_fields.WEIGHTS_FIELD: record_fields.weights(),
     # What an agent that learns by acting spent per seed (softbench.agents.training_summary).
     "training": {
       "type": "object",

@@ -74,12 +74,13 @@ def schema() -> dict:
     "per_seed": {"type": "array", "items": seed, "minItems": 1},
     **record_fields.properties(),
   }
+  optional = {record_fields.WEIGHTS_FIELD: record_fields.weights()}
   return {
     "$schema": "https://json-schema.org/draft/2020-12/schema",
     "title": "softbench Exp1S result record",
     "type": "object",
     "required": list(properties),
-    "properties": properties,
+    "properties": {**properties, **optional},
     "additionalProperties": record_fields.section(),
   }
 

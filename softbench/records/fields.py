@@ -37,6 +37,40 @@ def non_negative(maximum: float = MAX_ERROR) -> dict:
   return {"type": "number", "minimum": 0, "maximum": maximum}
 
 
+WEIGHTS_FIELD = "weights"
+"""The optional section that names, per seed, the sha256 of each weight file behind its scores."""
+SHA256_PATTERN = "^[0-9a-f]{64}$"
+
+
+def weights() -> dict:
+  """The ``weights`` section (``softbench.zoo.weights_section``): per seed, the data-home path
+  of each file the seed's agent was made of (checkpoint, forward models) and its sha256."""
+  return {
+    "type": "object",
+    "required": ["per_seed"],
+    "additionalProperties": False,
+    "properties": {
+      "per_seed": {
+        "type": "array",
+        "minItems": 1,
+        "items": {
+          "type": "object",
+          "required": ["seed", "files"],
+          "additionalProperties": False,
+          "properties": {
+            "seed": {"type": "integer", "minimum": 0},
+            "files": {
+              "type": "object",
+              "minProperties": 1,
+              "additionalProperties": {"type": "string", "pattern": SHA256_PATTERN},
+            },
+          },
+        },
+      }
+    },
+  }
+
+
 def section() -> dict:
   """An extra field: allowed only as a JSON object (a fault, an adaptive schedule, ...)."""
   return {"type": "object"}
@@ -64,7 +98,7 @@ def properties() -> dict:
 
 def check(record: dict, refuse: Refuse, seed_entries: int | None = None) -> None:
   """One entry per seed (``seed_entries`` entries where given), no seed twice, the profile's
-  settings under its name, a dated record."""
+  settings under its name, a dated record, weights named once per seed of the record."""
   per_seed = record["per_seed"]
   if seed_entries is not None and len(per_seed) != seed_entries:
     refuse(f"per_seed has {len(per_seed)} entries, {seed_entries} expected")
@@ -84,3 +118,6 @@ def check(record: dict, refuse: Refuse, seed_entries: int | None = None) -> None
     refuse(f"date {record['date']!r} is not an ISO 8601 date and time")
   if date.tzinfo is None:
     refuse(f"date {record['date']!r} has no time zone")
+  weighed = [entry["seed"] for entry in record.get(WEIGHTS_FIELD, {}).get("per_seed", [])]
+  if len(set(weighed)) != len(weighed) or any(seed >= record["seeds"] for seed in weighed):
+    refuse(f"weights names seeds {weighed}: repeated, or beyond the record's {record['seeds']}")

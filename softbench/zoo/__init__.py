@@ -195,6 +195,26 @@ def section(taken: list[str]) -> dict:
   return {"zoo": {"files": sorted(taken)}} if taken else {}
 
 
+def weights(per_seed_files: list[list[pathlib.Path]]) -> list[dict[str, str]]:
+  """Per seed, the sha256 of each of its files (cache files of the data home) by data-home path;
+  a file the home lacks is left out."""
+  home = storage.softbench_home()
+  return [
+    {path.relative_to(home).as_posix(): file_sha256(path) for path in files if path.is_file()}
+    for files in per_seed_files
+  ]
+
+
+def weights_section(per_seed_files: list[list[pathlib.Path]]) -> dict:
+  """The record section that names, per seed, the weight files its scores came from and their
+  sha256 (``weights``), so that ``softbench zoo add`` links a record only to the weights that made
+  it; none when no seed has a file."""
+  hashed = [
+    {"seed": seed, "files": files} for seed, files in enumerate(weights(per_seed_files)) if files
+  ]
+  return {"weights": {"per_seed": hashed}} if hashed else {}
+
+
 def _copy_checked(zoo: pathlib.Path, entry: Entry, home: pathlib.Path) -> bool:
   """Copies the zoo's ``entry`` into the data home if its bytes match the manifest's sha256."""
   source = zoo / entry.path

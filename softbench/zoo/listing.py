@@ -34,15 +34,26 @@ def contents(folder: pathlib.Path) -> RenderableType:
   )
 
 
-def additions(added: list[zoo.Entry], skipped: list[pathlib.Path], folder: pathlib.Path) -> str:
-  """What ``zoo.add`` did (its ``added`` entries and ``skipped`` cache files), then how much the
-  zoo ``folder`` holds now; one fact a line."""
+def additions(
+  added: list[zoo.Entry],
+  skipped: list[pathlib.Path],
+  folder: pathlib.Path,
+  unchecked: list[str] = (),
+) -> str:
+  """What ``zoo.add`` did (its ``added`` entries and ``skipped`` cache files), the records left
+  unlinked because they name no weights (``unchecked``), then how much the zoo ``folder`` holds
+  now; one fact a line."""
   lines = [
     f"added {entry.path} ({entry.kind}, {entry.bytes / KIB:.1f} KiB, {len(entry.records)} records)"
     for entry in added
   ]
   lines += [
     f"skipped {path.name}: its training has not started in the data home" for path in skipped
+  ]
+  lines += [
+    f"not linked {name}: it names no weights (made before records did); --link-unchecked "
+    f"links it, softbench zoo verify checks it"
+    for name in unchecked
   ]
   lines.append(f"zoo: {usage(folder, zoo.read_manifest(folder))}")
   return "\n".join(lines)
