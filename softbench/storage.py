@@ -5,11 +5,15 @@ The data home is ``$SOFTBENCH_HOME`` if set, else ``$XDG_CACHE_HOME/softbench`` 
 ``os.replace``, so a reader sees the old file or the new one, never half of one.
 """
 
+from collections.abc import Iterator
+import contextlib
 import dataclasses
+import fcntl
 import hashlib
 import io
 import os
 import pathlib
+import sys
 import tempfile
 
 import numpy as np
@@ -21,6 +25,8 @@ from smpl.files import read_cached  # noqa: F401
 from smpl.files import write_cache_file  # noqa: F401  (softbench's caches write through it)
 
 HOME_VARIABLE = "SOFTBENCH_HOME"
+LOCKS_FOLDER = ".locks"  # In the data home: ``made_alone``'s lock files.
+_HELD: set[pathlib.Path] = set()  # The lock files this process holds (``made_alone`` nests).
 
 
 def softbench_home() -> pathlib.Path:
@@ -37,6 +43,55 @@ def write_atomically(path: pathlib.Path, content: str | bytes) -> None:
   (``smpl.files.write_atomically``). A failed write removes the temporary file and raises
   its error, naming ``path`` (a full disk says which file it could not write)."""
   files.write_atomically(path, content)
+
+
+@contextlib.contextmanager
+def made_alone(path: pathlib.Path, what: str, home: pathlib.Path | None = None) -> Iterator[None]:
+  """Holds an exclusive lock on making ``path`` (a cache file or folder of the data home
+  ``home``, by default ``softbench_home()``) for the block, so that processes sharing a data home
+  do not train or collect the same thing at once: a second one waits, saying so in one line on
+  stderr, and then finds it made (the caller reads the cache again inside the block). The lock
+  (``flock``, released when its process ends, even killed) is a file in ``home/LOCKS_FOLDER``;
+  where the file system cannot lock, the block runs unlocked, as before."""
+  home = softbench_home() if home is None else pathlib.Path(home)
+  try:
+    name = path.resolve().relative_to(home.resolve()).as_posix().replace("/", "--")
+  except ValueError:  # Outside the data home: named by its absolute path.
+    name = hashlib.sha256(str(path.resolve()).encode()).hexdigest()[:16]
+  lock_path = home / LOCKS_FOLDER / f"{name}.lock"
+  if lock_path in _HELD:  # Held already by this process, further up the stack.
+    yield
+    return
+  try:
+    lock_path.parent.mkdir(parents=True, exist_ok=True)
+    handle = open(lock_path, "a")  # noqa: SIM115  (closed below)
+  except OSError:  # A read-only home: nothing is made there either, so nothing to guard.
+    handle = None
+  try:
+    if handle is not None:
+      _lock(handle, f"{what} {path.name}")
+      _HELD.add(lock_path)
+    yield
+  finally:
+    if handle is not None:
+      _HELD.discard(lock_path)
+      handle.close()  # Releases the lock.
+
+
+def _lock(handle, making: str) -> None:
+  """Takes ``handle``'s exclusive lock, waiting (and saying so) while another process holds it;
+  nothing if the file system cannot lock."""
+  try:
+    fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+  except BlockingIOError:
+    print(
+      f"softbench: waiting for another process making the {making} (it holds the lock)",
+      file=sys.stderr,
+      flush=True,
+    )
+    fcntl.flock(handle, fcntl.LOCK_EX)
+  except OSError:  # No locks on this file system (some network mounts).
+    pass
 
 
 def check_writable(path: str | os.PathLike, what: str, folder: bool = False) -> pathlib.Path:

@@ -7,6 +7,8 @@ seconds; every test writes under its own temporary SOFTBENCH_HOME, never the rea
 import hashlib
 import json
 import pathlib
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -551,3 +553,36 @@ def test_a_failed_atomic_write_leaves_no_temporary_file(failure, tmp_path, monke
     storage.write_atomically(target, "new")
   assert sorted(path.name for path in tmp_path.iterdir()) == ["file.txt"]
   assert failure == "target is a folder" or target.read_text() == "old"
+
+
+WAIT_FOR_THE_LOCK = """
+import sys
+from softbench.data import babbling
+
+def refuse(*args, **kwargs):
+  raise AssertionError("collected although another process had")
+
+babbling._collected = refuse
+babbling.collect(**{config}, chunk_length={chunk}, workers=1, progress=False)
+print("found it")
+"""
+
+
+def test_a_second_process_waits_for_the_collection_under_way_and_then_reads_it():
+  """Two processes sharing a data home collect a dataset once: the second waits on the first's
+  lock (one line), then finds the dataset made instead of collecting it again."""
+  folder = dataset.dataset_folder(small_config())
+  with storage.made_alone(folder, "babbling dataset"):
+    second = subprocess.Popen(
+      [sys.executable, "-c", WAIT_FOR_THE_LOCK.format(config=SMALL, chunk=CHUNK)],
+      stdout=subprocess.PIPE,
+      stderr=subprocess.PIPE,
+      text=True,
+    )
+    waiting = second.stderr.readline()  # Blocks until the second process reaches the lock.
+    assert waiting.startswith("softbench: waiting for another process making the babbling dataset")
+    assert second.poll() is None
+    collect(workers=1)  # Inside the held lock: it nests in this process.
+  out, err = second.communicate(timeout=120)
+  assert second.returncode == 0, err
+  assert out.strip() == "found it"

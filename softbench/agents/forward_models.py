@@ -95,35 +95,45 @@ def prepare(
 ) -> tuple[list[data.SplitWindows], list[smpl_forward.ForwardModel]]:
   """Each view's windows of ``dataset`` (``samples`` babbling samples of seed ``data_seed``) and
   its frozen forward model trained with ``config``: from the cache, or trained now (with an epoch
-  progress bar named ``progress_label VIEW`` if given) and cached."""
+  progress bar named ``progress_label VIEW`` if given) and cached; another process sharing the
+  data home waits meanwhile (``storage.made_alone``) and then loads it."""
   windows, forwards = [], []
   for view, key in zip(views, configs(robot, views, samples, data_seed, config, training_version)):
     path = cache_file(key)
     partial = path.with_suffix(".partial")  # Its training snapshots until it is saved.
     zoo.restore(path)
-    cached = storage.read_cached(
-      path, lambda found: _load(found, key, dataset, view), "forward model", "training it again"
-    )
-    if cached:
-      split, model = cached
-    else:
-      with (
-        snapshots.resumable(partial),
-        (
-          progress.EpochProgressBar(f"{progress_label} {view.name}", config.max_epochs)
-          if progress_label
-          else contextlib.nullcontext(None)
-        ) as bar,
-      ):
-        column = protocols.prepare_column(
-          robot, view, dataset, config, training.default_device(), bar
-        )
-      split, model = column.windows, column.forward_model
-      checkpoint.save_checkpoint(path, model, key)
-      snapshots.discard(partial)
+    cached = _cached(path, key, dataset, view)
+    if cached is None:
+      with storage.made_alone(path, "forward model"):
+        cached = _cached(path, key, dataset, view)  # Trained meanwhile by another process?
+        if cached is None:
+          with (
+            snapshots.resumable(partial),
+            (
+              progress.EpochProgressBar(f"{progress_label} {view.name}", config.max_epochs)
+              if progress_label
+              else contextlib.nullcontext(None)
+            ) as bar,
+          ):
+            column = protocols.prepare_column(
+              robot, view, dataset, config, training.default_device(), bar
+            )
+          cached = column.windows, column.forward_model
+          checkpoint.save_checkpoint(path, column.forward_model, key)
+          snapshots.discard(partial)
+    split, model = cached
     windows.append(split)
     forwards.append(model.eval())
   return windows, forwards
+
+
+def _cached(
+  path: pathlib.Path, key: ForwardModelConfig, dataset: data.Dataset, view: data.View
+) -> tuple[data.SplitWindows, smpl_forward.ForwardModel] | None:
+  """``_load`` of the cached file, None if there is none (or it is damaged: reported once)."""
+  return storage.read_cached(
+    path, lambda found: _load(found, key, dataset, view), "forward model", "training it again"
+  )
 
 
 def _load(

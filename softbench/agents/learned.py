@@ -590,7 +590,8 @@ def load_or_train(
   the file is damaged in any way (``storage.read_cached``: one ``CorruptFileWarning``),
   ``train()``'s, trained so that an interrupted training resumes
   (snapshots in ``snapshot_folder(path)``) and then saved there: normalisation i as
-  ``parts[i]/KEY``, the further arrays under their own names (no part's prefix)."""
+  ``parts[i]/KEY``, the further arrays under their own names (no part's prefix). Another process
+  sharing the data home waits meanwhile (``storage.made_alone``) and then loads it."""
   zoo.restore(path)
 
   def read(found: pathlib.Path) -> TrainedModels:
@@ -614,6 +615,16 @@ def load_or_train(
   cached = storage.read_cached(path, read, "checkpoint", "training it again")
   if cached is not None:
     return cached
+  with storage.made_alone(path, "checkpoint"):
+    # Another process sharing the data home may have trained it while this one waited.
+    cached = storage.read_cached(path, read, "checkpoint", "training it again")
+    return cached if cached is not None else _train_and_save(path, config, parts, train)
+
+
+def _train_and_save(
+  path: pathlib.Path, config, parts: list[str], train: Callable[[], TrainedModels]
+) -> TrainedModels:
+  """``train()``'s models, trained resumably and saved at ``path`` (``load_or_train``)."""
   with snapshots.resumable(snapshot_folder(path)):
     models = train()
   if set(key.split("/")[0] for key in models.arrays) & set(parts):

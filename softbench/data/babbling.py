@@ -73,15 +73,39 @@ def collect(
   dataset.check_count("workers", workers)
   dataset.check_count("chunk_length", chunk_length)
   folder = dataset.dataset_folder(config, home)
-  found = storage.read_cached(
+  found = _found(folder, config)
+  if found is not None:
+    return found
+  with storage.made_alone(folder, "babbling dataset", home):
+    # Another process sharing the data home may have collected it while this one waited.
+    found = _found(folder, config)
+    if found is not None:
+      return found
+    return _collected(arm, config, seed, folder, workers, chunk_length, progress)
+
+
+def _found(folder: pathlib.Path, config: dict) -> dataset.Dataset | None:
+  """The dataset of ``config`` in ``folder``, None if it is not there (or damaged: reported)."""
+  return storage.read_cached(
     folder / dataset.JSON_NAME,
     lambda _: dataset.read(folder, config),
     "dataset",
     "collecting it again",
     (folder / dataset.NPZ_NAME,),
   )
-  if found is not None:
-    return found
+
+
+def _collected(
+  arm: robots.SoftArm,
+  config: dict,
+  seed: int,
+  folder: pathlib.Path,
+  workers: int,
+  chunk_length: int,
+  progress: bool,
+) -> dataset.Dataset:
+  """Collects the dataset of ``config`` (action streams of ``seed``) into ``folder``, resuming its
+  saved chunks (``collect``)."""
   started = time.perf_counter()
   lengths = config["episode_lengths"]
   actions = babbling_actions(arm, seed, lengths)
