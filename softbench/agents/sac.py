@@ -248,14 +248,28 @@ def train(
   robot: robot_base.SoftArm, seed: int, profile: profiles.Profile, show_progress: bool = False
 ) -> dict:
   """The trained model of ``seed`` (its saved dict): from the cache, or trained now (resuming a
-  saved state) and cached."""
+  saved state) and cached; another process sharing the data home waits meanwhile
+  (``storage.made_alone``) and then loads it."""
   config = training_config(robot, seed, profile)
   path = checkpoint_path(robot, seed, profile)
-  finished = storage.read_cached(
+  cached = lambda: storage.read_cached(
     path, lambda file: _read(file, config, "model"), "cached sac model", "training it again"
   )
+  finished = cached()
   if finished is not None:
     return finished
+  with storage.made_alone(path, "sac model"):
+    # Another process sharing the data home may have trained it while this one waited.
+    finished = cached()
+    return finished if finished is not None else _trained(robot, seed, profile, show_progress)
+
+
+def _trained(
+  robot: robot_base.SoftArm, seed: int, profile: profiles.Profile, show_progress: bool
+) -> dict:
+  """``train``'s model, trained now (resuming a saved state) and cached."""
+  config = training_config(robot, seed, profile)
+  path = checkpoint_path(robot, seed, profile)
   partial = path.with_suffix(".partial.pt")
   state = storage.read_cached(
     partial,
