@@ -191,3 +191,24 @@ def test_reach_completion_reports_every_mode_of_every_agent(monkeypatch, capsys,
     low, median, high = row["episode_mean_mm"]
     assert 0 <= low <= median <= high and len(row["final_mm"]) == 3
   assert out.count("(quartiles over 2 targets)") == 4
+
+
+def test_smpl_width_reproduces_smpl_at_the_papers_size_and_trains_other_sizes(monkeypatch, capsys):
+  out = run_script(
+    "smpl_width",
+    [
+      *("--robot", "tendon-2", "--profile", "tiny", "--task", "circle"),
+      *("--columns", "32x2", "16x1"),
+    ],
+    monkeypatch,
+    capsys,
+  )
+  scores = dict(re.findall(r"^smpl (\d+x\d) .* position error ([0-9.]+) mm", out, re.MULTILINE))
+  assert set(scores) == {"32x2", "16x1"}
+  record = run.execute(
+    run.settings("circle", "smpl", "tendon-2", seeds=1, profile="tiny"),
+    show_progress=False,
+    workers=1,
+  )
+  assert scores["32x2"] == f"{record['per_seed'][0]['position_mm']['mean']:.4f}"
+  assert scores["16x1"] != scores["32x2"]
