@@ -359,6 +359,26 @@ def test_the_overview_shows_the_papers_value_beside_ours(real_record, tmp_path):
     assert cell.endswith(f" ({overview.paper_mean(view.robot, 'circle', 'smpl'):.2f})")
 
 
+def test_every_page_marks_the_figures_of_completed_targets(real_record, tmp_path):
+  """A reach record whose agent completed the point (``helpers``) carries the mark in the
+  overviews of the markdown page and the HTML page; one that held the other modules does not."""
+  folder = tmp_path / "results"
+  reach = position_only(real_record)
+  records.write(variant(reach, agent="smpl", helpers="complete"), folder / "smpl.json")
+  records.write(variant(reach, agent="lstm", helpers="hold"), folder / "lstm.json")
+  board = leaderboard.build(folder)
+  (view,) = overview.overviews(board)
+  assert view.marks == {("smpl", "reach"): ranking.COMPLETED_MARK, ("lstm", "reach"): ""}
+  cells = {row[0]: row[1] for row in view.table.rows}
+  assert cells["smpl"].endswith(ranking.COMPLETED_MARK)
+  assert not cells["lstm"].endswith(ranking.COMPLETED_MARK)
+  leaderboard.write(board, folder, tmp_path / "site")
+  page = (tmp_path / "site" / "index.html").read_text()
+  overview_html = page[page.index(view.anchor) :]
+  overview_html = overview_html[: overview_html.index("</table>")]
+  assert overview_html.count(ranking.COMPLETED_MARK) == 2  # The caption's note and smpl's cell.
+
+
 def test_pages_contain_every_record(results, tmp_path, capsys):
   out = tmp_path / "site"
   assert cli.main(["leaderboard", "--results", str(results), "--write", "--out", str(out)]) == 0

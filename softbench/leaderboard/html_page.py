@@ -75,11 +75,12 @@ class Board:
   image: str | None = None  # A figure file beside the page.
 
 
-def _figure(estimate: ranking.Estimate | None, paper: float | None = None) -> Cell:
+def _figure(estimate: ranking.Estimate | None, paper: float | None = None, mark: str = "") -> Cell:
+  """A mean ± std cell (followed by ``mark``), with its interval and the paper's value."""
   if estimate is None:
     return Cell("-")
   return Cell(
-    ranking.mean_and_std(estimate),
+    ranking.mean_and_std(estimate) + mark,
     estimate.mean,
     None if estimate.interval is None else ranking.interval_text(estimate),
     None if paper is None else f"{paper:.2f}",
@@ -155,7 +156,11 @@ def _overview_board(view: overview.Overview) -> Board:
     (
       Cell(agent),
       *(
-        _figure(view.estimates.get((agent, task)), overview.paper_mean(view.robot, task, agent))
+        _figure(
+          view.estimates.get((agent, task)),
+          overview.paper_mean(view.robot, task, agent),
+          view.marks.get((agent, task), ""),
+        )
         for task in tasks
       ),
     )

@@ -43,6 +43,8 @@ class Overview:
   eval_mode: str
   table: Table
   estimates: dict[tuple[str, str], ranking.Estimate]  # By (agent, task), for the table's cells.
+  marks: dict[tuple[str, str], str] = dataclasses.field(default_factory=dict)
+  """By (agent, task): ``ranking.COMPLETED_MARK`` after a completed target's figure, else ''."""
 
   @property
   def title(self) -> str:
@@ -110,6 +112,7 @@ def overviews(board: ranking.Leaderboard) -> tuple[Overview, ...]:
         eval_mode,
         Table(caption, ("agent", *tasks), rows, label_columns=1),
         estimates,
+        marks[robot, profile, eval_mode],
       )
     )
   return tuple(
