@@ -5,6 +5,7 @@ The data home is ``$SOFTBENCH_HOME`` if set, else ``$XDG_CACHE_HOME/softbench`` 
 ``os.replace``, so a reader sees the old file or the new one, never half of one.
 """
 
+from collections.abc import Callable
 from collections.abc import Iterator
 import contextlib
 import dataclasses
@@ -15,6 +16,7 @@ import os
 import pathlib
 import sys
 import tempfile
+from typing import TypeVar
 
 import numpy as np
 
@@ -27,6 +29,7 @@ from smpl.files import write_cache_file  # noqa: F401  (softbench's caches write
 HOME_VARIABLE = "SOFTBENCH_HOME"
 LOCKS_FOLDER = ".locks"  # In the data home: ``made_alone``'s lock files.
 _HELD: set[pathlib.Path] = set()  # The lock files this process holds (``made_alone`` nests).
+T = TypeVar("T")
 
 
 def softbench_home() -> pathlib.Path:
@@ -76,6 +79,23 @@ def made_alone(path: pathlib.Path, what: str, home: pathlib.Path | None = None) 
     if handle is not None:
       _HELD.discard(lock_path)
       handle.close()  # Releases the lock.
+
+
+def found_or_made(
+  path: pathlib.Path,
+  find: Callable[[], T | None],
+  make: Callable[[], T],
+  what: str,
+  home: pathlib.Path | None = None,
+) -> T:
+  """``find()``'s cached thing at ``path``, else ``make()``'s, made under ``made_alone`` after
+  finding once more (another process sharing the data home may have made it meanwhile)."""
+  found = find()
+  if found is not None:
+    return found
+  with made_alone(path, what, home):
+    found = find()
+    return found if found is not None else make()
 
 
 def _lock(handle, making: str) -> None:

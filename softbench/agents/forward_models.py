@@ -96,32 +96,32 @@ def prepare(
   """Each view's windows of ``dataset`` (``samples`` babbling samples of seed ``data_seed``) and
   its frozen forward model trained with ``config``: from the cache, or trained now (with an epoch
   progress bar named ``progress_label VIEW`` if given) and cached; another process sharing the
-  data home waits meanwhile (``storage.made_alone``) and then loads it."""
+  data home waits meanwhile (``storage.found_or_made``) and then loads it."""
   windows, forwards = [], []
   for view, key in zip(views, configs(robot, views, samples, data_seed, config, training_version)):
     path = cache_file(key)
     partial = path.with_suffix(".partial")  # Its training snapshots until it is saved.
     zoo.restore(path)
-    cached = _cached(path, key, dataset, view)
-    if cached is None:
-      with storage.made_alone(path, "forward model"):
-        cached = _cached(path, key, dataset, view)  # Trained meanwhile by another process?
-        if cached is None:
-          with (
-            snapshots.resumable(partial),
-            (
-              progress.EpochProgressBar(f"{progress_label} {view.name}", config.max_epochs)
-              if progress_label
-              else contextlib.nullcontext(None)
-            ) as bar,
-          ):
-            column = protocols.prepare_column(
-              robot, view, dataset, config, training.default_device(), bar
-            )
-          cached = column.windows, column.forward_model
-          checkpoint.save_checkpoint(path, column.forward_model, key)
-          snapshots.discard(partial)
-    split, model = cached
+
+    def train() -> tuple[data.SplitWindows, smpl_forward.ForwardModel]:
+      with (
+        snapshots.resumable(partial),
+        (
+          progress.EpochProgressBar(f"{progress_label} {view.name}", config.max_epochs)
+          if progress_label
+          else contextlib.nullcontext(None)
+        ) as bar,
+      ):
+        column = protocols.prepare_column(
+          robot, view, dataset, config, training.default_device(), bar
+        )
+      checkpoint.save_checkpoint(path, column.forward_model, key)
+      snapshots.discard(partial)
+      return column.windows, column.forward_model
+
+    split, model = storage.found_or_made(
+      path, lambda: _cached(path, key, dataset, view), train, "forward model"
+    )
     windows.append(split)
     forwards.append(model.eval())
   return windows, forwards

@@ -591,7 +591,7 @@ def load_or_train(
   ``train()``'s, trained so that an interrupted training resumes
   (snapshots in ``snapshot_folder(path)``) and then saved there: normalisation i as
   ``parts[i]/KEY``, the further arrays under their own names (no part's prefix). Another process
-  sharing the data home waits meanwhile (``storage.made_alone``) and then loads it."""
+  sharing the data home waits meanwhile (``storage.found_or_made``) and then loads it."""
   zoo.restore(path)
 
   def read(found: pathlib.Path) -> TrainedModels:
@@ -612,13 +612,12 @@ def load_or_train(
     }
     return TrainedModels(inverse, forwards, normalisations, arrays)
 
-  cached = storage.read_cached(path, read, "checkpoint", "training it again")
-  if cached is not None:
-    return cached
-  with storage.made_alone(path, "checkpoint"):
-    # Another process sharing the data home may have trained it while this one waited.
-    cached = storage.read_cached(path, read, "checkpoint", "training it again")
-    return cached if cached is not None else _train_and_save(path, config, parts, train)
+  return storage.found_or_made(
+    path,
+    lambda: storage.read_cached(path, read, "checkpoint", "training it again"),
+    lambda: _train_and_save(path, config, parts, train),
+    "checkpoint",
+  )
 
 
 def _train_and_save(

@@ -249,19 +249,17 @@ def train(
 ) -> dict:
   """The trained model of ``seed`` (its saved dict): from the cache, or trained now (resuming a
   saved state) and cached; another process sharing the data home waits meanwhile
-  (``storage.made_alone``) and then loads it."""
+  (``storage.found_or_made``) and then loads it."""
   config = training_config(robot, seed, profile)
   path = checkpoint_path(robot, seed, profile)
-  cached = lambda: storage.read_cached(
-    path, lambda file: _read(file, config, "model"), "cached sac model", "training it again"
+  return storage.found_or_made(
+    path,
+    lambda: storage.read_cached(
+      path, lambda file: _read(file, config, "model"), "cached sac model", "training it again"
+    ),
+    lambda: _trained(robot, seed, profile, show_progress),
+    "sac model",
   )
-  finished = cached()
-  if finished is not None:
-    return finished
-  with storage.made_alone(path, "sac model"):
-    # Another process sharing the data home may have trained it while this one waited.
-    finished = cached()
-    return finished if finished is not None else _trained(robot, seed, profile, show_progress)
 
 
 def _trained(

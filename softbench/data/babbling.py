@@ -73,15 +73,13 @@ def collect(
   dataset.check_count("workers", workers)
   dataset.check_count("chunk_length", chunk_length)
   folder = dataset.dataset_folder(config, home)
-  found = _found(folder, config)
-  if found is not None:
-    return found
-  with storage.made_alone(folder, "babbling dataset", home):
-    # Another process sharing the data home may have collected it while this one waited.
-    found = _found(folder, config)
-    if found is not None:
-      return found
-    return _collected(arm, config, seed, folder, workers, chunk_length, progress)
+  return storage.found_or_made(
+    folder,
+    lambda: _found(folder, config),
+    lambda: _collected(arm, config, seed, folder, workers, chunk_length, progress),
+    "babbling dataset",
+    home,
+  )
 
 
 def _found(folder: pathlib.Path, config: dict) -> dataset.Dataset | None:
