@@ -215,12 +215,18 @@ def _add_eval_argument(parser: argparse.ArgumentParser) -> None:
   )
 
 
-def _add_record_arguments(parser: argparse.ArgumentParser) -> None:
+def _add_results_argument(
+  parser: argparse.ArgumentParser, what: str = "folder of the result records"
+) -> None:
   parser.add_argument(
     "--results",
-    default="leaderboard/results",
-    help="folder of the result records (default leaderboard/results)",
+    default=str(leaderboard.DEFAULT_RESULTS),
+    help=f"{what} (default {leaderboard.DEFAULT_RESULTS})",
   )
+
+
+def _add_record_arguments(parser: argparse.ArgumentParser) -> None:
+  _add_results_argument(parser)
   parser.add_argument("--json", help="also write the result record to this file")
 
 
@@ -527,11 +533,7 @@ def build_parser() -> argparse.ArgumentParser:
     help="the data home of this machine and every worker, e.g. on shared storage "
     "(default: $SOFTBENCH_HOME)",
   )
-  sweep_parser.add_argument(
-    "--results",
-    default="leaderboard/results",
-    help="folder of the result records (default leaderboard/results)",
-  )
+  _add_results_argument(sweep_parser)
   sweep_parser.set_defaults(run=_sweep)
 
   board_parser = commands.add_parser(
@@ -541,11 +543,7 @@ def build_parser() -> argparse.ArgumentParser:
     "and task, the newest record of each agent, profile and eval mode, ranked by "
     "position error: mean ± std over seeds [95% bootstrap CI].",
   )
-  board_parser.add_argument(
-    "--results",
-    default=str(leaderboard.DEFAULT_RESULTS),
-    help=f"folder of the result records (default {leaderboard.DEFAULT_RESULTS})",
-  )
+  _add_results_argument(board_parser)
   board_parser.add_argument(
     "--write",
     action="store_true",
@@ -658,9 +656,7 @@ def _add_zoo_parser(commands) -> None:
   )
   add_parser.add_argument("--seeds", type=int, help="seeds 0 .. N-1 (default: the profile's)")
   _add_profile_argument(add_parser)
-  add_parser.add_argument(
-    "--results", default=str(leaderboard.DEFAULT_RESULTS), help="folder of the records to link"
-  )
+  _add_results_argument(add_parser, "folder of the records to link")
   add_parser.add_argument(
     "--link-unchecked",
     action="store_true",
@@ -679,9 +675,7 @@ def _add_zoo_parser(commands) -> None:
   verify_parser.add_argument(
     "--quick", action="store_true", help="seed 0 only, one record per checkpoint"
   )
-  verify_parser.add_argument(
-    "--results", default=str(leaderboard.DEFAULT_RESULTS), help="folder of the records"
-  )
+  _add_results_argument(verify_parser, "folder of the records to verify")
   verify_parser.add_argument("--zoo", help=zoo_help)
   verify_parser.set_defaults(run=_zoo_verify)
 
