@@ -212,3 +212,23 @@ def test_smpl_width_reproduces_smpl_at_the_papers_size_and_trains_other_sizes(mo
   )
   assert scores["32x2"] == f"{record['per_seed'][0]['position_mm']['mean']:.4f}"
   assert scores["16x1"] != scores["32x2"]
+
+
+def test_smpl_forward_views_reproduces_smpl_and_trains_through_every_actuation(monkeypatch, capsys):
+  out = run_script(
+    "smpl_forward_views",
+    ["--robot", "tendon-2", "--profile", "tiny", "--task", "circle", "--views", "own", "every"],
+    monkeypatch,
+    capsys,
+  )
+  scores = dict(
+    re.findall(r"^smpl forward views (\w+) .* position error ([0-9.]+) mm", out, re.MULTILINE)
+  )
+  assert set(scores) == {"own", "every"}
+  record = run.execute(
+    run.settings("circle", "smpl", "tendon-2", seeds=1, profile="tiny"),
+    show_progress=False,
+    workers=1,
+  )
+  assert scores["own"] == f"{record['per_seed'][0]['position_mm']['mean']:.4f}"
+  assert scores["every"] != scores["own"]

@@ -417,6 +417,12 @@ def test_view_sizes_for_every_robot(robot_name):
     assert view.pose_modules == (module - 1,)
     assert view.action_size == arm.actuators_per_module[module - 1]
     assert view.preceding_action_size == sum(arm.actuators_per_module[: module - 1])
+    every = data.View.module_reading_every_actuation(arm, module)
+    assert (every.pose_modules, every.action_indices) == (view.pose_modules, view.action_indices)
+    assert sorted(every.preceding_action_indices + every.action_indices) == list(
+      range(arm.action_dim)
+    )
+    assert every.name != view.name  # Their forward models are cached apart.
   with pytest.raises(ValueError):
     data.View.module(arm, arm.num_modules + 1)
 

@@ -15,7 +15,6 @@ Usage (datasets collected before, e.g. by `softbench run` on the same profile):
 """
 
 import argparse
-import dataclasses
 
 import torch
 
@@ -24,13 +23,6 @@ from softbench import profiles
 from softbench import protocols
 from softbench import robots
 from softbench.agents import learned
-
-
-def with_distal_actuation(robot: robots.SoftArm, module: int) -> data.View:
-  """Module ``module``'s view whose forward model also reads the distal modules' actuation."""
-  own = data.View.module(robot, module)
-  others = tuple(index for index in range(robot.action_dim) if index not in own.action_indices)
-  return dataclasses.replace(own, name=f"{own.name}-with-distal", preceding_action_indices=others)
 
 
 def main() -> None:
@@ -49,7 +41,10 @@ def main() -> None:
         protocols.prepare_column(
           robot, view, dataset, config, torch.device("cpu")
         ).forward_training.best_validation_loss
-        for view in (data.View.module(robot, module), with_distal_actuation(robot, module))
+        for view in (
+          data.View.module(robot, module),
+          data.View.module_reading_every_actuation(robot, module),
+        )
       ]
       print(
         f"{name} module {module}: forward model's validation pose MSE from modules "

@@ -5,6 +5,9 @@ A ``View`` picks one learner's poses and actions, for any number of modules:
   View.end_effector(robot)  the last module's pose and every action (Exp1S).
   View.module(robot, k)     module k's pose and own actions, with the actions of modules 1 .. k-1
                             as ``preceding_actions`` (Exp2S, Exp2R); k counts from 1 at the base.
+  View.module_reading_every_actuation(robot, k)
+                            the same, with every other module's actions as ``preceding_actions``
+                            (an analysis of what SMPL's forward models cannot see).
   View.whole_arm(robot)     every module's pose, flattened from the base, and every action
                             (centralised baselines).
 
@@ -64,6 +67,16 @@ class View:
       (module - 1,),
       _indices(slices[module - 1 : module]),
       _indices(slices[: module - 1]),
+    )
+
+  @classmethod
+  def module_reading_every_actuation(cls, robot: robots.SoftArm, module: int) -> "View":
+    """Module ``module``'s view whose forward model also reads the distal modules' actuation
+    (every module's but its own, base first, then its own)."""
+    own = cls.module(robot, module)
+    others = tuple(index for index in range(robot.action_dim) if index not in own.action_indices)
+    return dataclasses.replace(
+      own, name=f"{own.name}-every-actuation", preceding_action_indices=others
     )
 
   @classmethod
