@@ -396,6 +396,9 @@ TABLES: dict[str, Callable[[ranking.Leaderboard], Table]] = {
   "eval-modes-tendon-3-spiral": eval_modes_table(
     "tendon-3", "spiral", "default", ("physics", "model", "open-loop")
   ),
+  "eval-modes-tendon-local-3-spiral-paper": eval_modes_table(
+    "tendon-local-3", "spiral", "paper", ("physics", "model")
+  ),
   "exp1s-tendon-default": exp1s_table("tendon", "default"),
   "exp1s-tendon-paper": exp1s_table("tendon", "paper"),
   "exp1s-tendon-local-default": exp1s_table("tendon-local", "default"),
