@@ -11,6 +11,7 @@ import pytest
 
 from softbench import cli
 from softbench import data
+from softbench import records
 from softbench import run
 
 ANALYSIS = pathlib.Path(__file__).parent.parent / "docs" / "analysis"
@@ -232,3 +233,24 @@ def test_smpl_forward_views_reproduces_smpl_and_trains_through_every_actuation(m
   )
   assert scores["own"] == f"{record['per_seed'][0]['position_mm']['mean']:.4f}"
   assert scores["every"] != scores["own"]
+
+
+def test_smpl_joint_columns_trains_every_column_at_once_and_reads_the_record(
+  monkeypatch, capsys, tmp_path
+):
+  results = tmp_path / "results"
+  record = run.execute(
+    run.settings("circle", "smpl", "tendon-2", seeds=1, profile="tiny"),
+    show_progress=False,
+    workers=1,
+  )
+  records.write(record, results / "smpl.json")
+  arguments = ["--robot", "tendon-2", "--profile", "tiny", "--task", "circle"]
+  out = run_script(
+    "smpl_joint_columns", [*arguments, "--results", str(results)], monkeypatch, capsys
+  )
+  (line,) = re.findall(r"^smpl joint columns tendon-2 tiny seed 0: .*$", out, re.MULTILINE)
+  joint = re.search(r"circle position error ([0-9.]+) mm", line).group(1)
+  recorded = f"{record['per_seed'][0]['position_mm']['mean']:.4f}"
+  assert f"the record: {recorded} mm" in line
+  assert joint != recorded  # Trained otherwise, so scored otherwise.

@@ -1,0 +1,113 @@
+"""SMPL with its columns trained together: is its gap to the centralised learners one of the order
+its columns train in?
+
+`softbench run` trains SMPL's columns one after another (the paper's progressive scheme): column 1
+on module 1 alone, then frozen, column 2 beside it, and so on, each column's loss the action error
+of its own module. So column 1 is fixed before any distal column exists. This trains the same
+network (the paper's columns, the same seed's initial weights, the committed hyperparameters,
+the same per-module forward models and closed-loop rollout, ``smpl.rollout.joint_rollout``) with
+every column trainable at once on the mean action error over all modules, for up to as many
+epochs as the columns get together (the profile's epochs times the modules), and scores it
+closed loop in physics on --task beside the committed record of `softbench run`'s SMPL for the
+same seed (read from --results). Nothing is cached but the forward models.
+
+Usage (the forward models train first if the data home lacks them):
+  python docs/analysis/smpl_joint_columns.py --robot tendon-local-3 --profile default \
+      --seeds 0 1 2 --task spiral
+"""
+
+import argparse
+import dataclasses
+import time
+
+import torch
+from torch import nn
+
+from smpl import rollout
+from smpl import training
+from smpl import windows as smpl_windows
+from softbench import leaderboard
+from softbench import profiles
+from softbench import records
+from softbench import robots
+from softbench import run
+from softbench.agents import hyperparameters
+from softbench.agents import learned
+from softbench.agents import learners
+
+
+def joint_loss(network, forwards) -> training.BatchLoss:
+  """The mean over modules of each module's action MSE, every column acting together."""
+
+  def loss(batch: smpl_windows.ModuleWindows) -> torch.Tensor:
+    results = rollout.joint_rollout(network, batch, forwards)
+    errors = [
+      nn.functional.mse_loss(result.actions, module.actions)
+      for result, module in zip(results, batch.modules)
+    ]
+    return sum(errors[1:], errors[0]) / len(errors)
+
+  return loss
+
+
+def recorded_score(folder: str, task: str, robot: str, profile: str, seed: int) -> str:
+  """Seed ``seed``'s module-averaged position error in the newest record of SMPL on this
+  setting, or "none" if there is no record (or it lacks the seed)."""
+  found = [
+    record
+    for _, record in records.read_folder(folder)
+    if tuple(record.get(key) for key in ("agent", "task", "robot", "profile", "eval_mode"))
+    == ("smpl", task, robot, profile, "physics")
+  ]
+  seeds = max(found, key=lambda record: record["date"])["per_seed"] if found else []
+  return f"{seeds[seed]['position_mm']['mean']:.4f} mm" if seed < len(seeds) else "none"
+
+
+def main() -> None:
+  parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+  parser.add_argument("--robot", default="tendon-local-3")
+  parser.add_argument("--profile", default="default")
+  parser.add_argument("--seeds", type=int, nargs="+", default=[0])
+  parser.add_argument("--task", default="spiral")
+  parser.add_argument("--results", default=str(leaderboard.DEFAULT_RESULTS))
+  args = parser.parse_args()
+
+  arm, profile = robots.make(args.robot), profiles.get(args.profile)
+  views = learners.views(arm, per_module=True)
+  params = hyperparameters.values("smpl", arm.name)
+  settings = run.settings(args.task, "smpl", args.robot, seeds=1, profile=args.profile)
+  device = training.default_device()
+  for seed in args.seeds:
+    windows, forwards = learned.trained_forward_models(arm, views, seed, profile)
+    with training.seeded(seed, torch.device("cpu")):
+      network, _ = learned.untrained(views, True, None, params)
+    _, config = learned.training_configs(seed, profile, params)
+    config = dataclasses.replace(config, max_epochs=profile.max_epochs * arm.num_modules)
+    for model in forwards:
+      model.to(device).eval()
+    split = lambda part: smpl_windows.ModuleWindows(tuple(getattr(w, part) for w in windows))
+    started = time.perf_counter()
+    result = training.fit(
+      network, joint_loss(network, forwards), split("train"), split("validation"), config, device
+    )
+    trained_s = time.perf_counter() - started
+    controllers = [
+      learned.Controller(view, forward.cpu().eval(), part.normalisation)
+      for view, forward, part in zip(views, forwards, windows)
+    ]
+    agent = learned.LearnedAgent(arm, seed, network.cpu().eval(), controllers)
+    entry, _ = run.evaluate(agent, arm, settings, seed)
+    position = entry["position_mm"]
+    recorded = recorded_score(args.results, args.task, args.robot, args.profile, seed)
+    print(
+      f"smpl joint columns {args.robot} {args.profile} seed {seed}: validation loss "
+      f"{result.best_validation_loss:.5f} after {result.epochs_run} epochs; {args.task} "
+      f"position error {position['mean']:.4f} mm, per module "
+      f"{[round(x, 3) for x in position['per_module']]} (trained in {trained_s:.0f} s; columns "
+      f"trained in order, the record: {recorded})",
+      flush=True,
+    )
+
+
+if __name__ == "__main__":
+  main()
