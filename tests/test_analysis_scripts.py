@@ -12,7 +12,11 @@ import pytest
 from softbench import cli
 from softbench import data
 from softbench import records
+from softbench import robots
 from softbench import run
+from softbench.agents import hyperparameters
+from softbench.agents import learned
+from softbench.agents import learners
 
 ANALYSIS = pathlib.Path(__file__).parent.parent / "docs" / "analysis"
 
@@ -253,4 +257,9 @@ def test_smpl_joint_columns_trains_every_column_at_once_and_reads_the_record(
   joint = re.search(r"circle position error ([0-9.]+) mm", line).group(1)
   recorded = f"{record['per_seed'][0]['position_mm']['mean']:.4f}"
   assert f"the record: {recorded} mm" in line
+  arm = robots.make("tendon-2")
+  network, _ = learned.untrained(
+    learners.views(arm, per_module=True), True, None, hyperparameters.values("smpl", arm.name)
+  )
+  assert f"({sum(p.numel() for p in network.parameters()):,} parameters trained" in line
   assert joint != recorded  # Trained otherwise, so scored otherwise.

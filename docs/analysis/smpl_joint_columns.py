@@ -81,6 +81,7 @@ def main() -> None:
     windows, forwards = learned.trained_forward_models(arm, views, seed, profile)
     with training.seeded(seed, torch.device("cpu")):
       network, _ = learned.untrained(views, True, None, params)
+    network.requires_grad_(True)  # Adding a column froze the ones before it.
     _, config = learned.training_configs(seed, profile, params)
     config = dataclasses.replace(config, max_epochs=profile.max_epochs * arm.num_modules)
     for model in forwards:
@@ -91,6 +92,7 @@ def main() -> None:
       network, joint_loss(network, forwards), split("train"), split("validation"), config, device
     )
     trained_s = time.perf_counter() - started
+    trained = sum(p.numel() for p in network.parameters() if p.requires_grad)
     controllers = [
       learned.Controller(view, forward.cpu().eval(), part.normalisation)
       for view, forward, part in zip(views, forwards, windows)
@@ -103,8 +105,8 @@ def main() -> None:
       f"smpl joint columns {args.robot} {args.profile} seed {seed}: validation loss "
       f"{result.best_validation_loss:.5f} after {result.epochs_run} epochs; {args.task} "
       f"position error {position['mean']:.4f} mm, per module "
-      f"{[round(x, 3) for x in position['per_module']]} (trained in {trained_s:.0f} s; columns "
-      f"trained in order, the record: {recorded})",
+      f"{[round(x, 3) for x in position['per_module']]} ({trained:,} parameters trained in "
+      f"{trained_s:.0f} s; columns trained in order, the record: {recorded})",
       flush=True,
     )
 
