@@ -105,6 +105,7 @@ def joint_rollout(
   windows: ModuleWindows,
   forward_models: Sequence[ForwardModel],
   feed_back_error: bool = True,
+  acted_preceding: bool = False,
 ) -> list[Rollout]:
   """Runs columns 0..len(windows.modules)-1 together, column j on module j's own inputs.
 
@@ -113,6 +114,11 @@ def joint_rollout(
   module j's forward model turns a'^j_t into the next error e^j_{t+1}. Through the lateral
   connections a distal column sees the proximal columns' features of their own targets and
   errors, which its module's pose depends on.
+
+  Module j's forward model reads the preceding modules' recorded actuation (the paper's design),
+  or with `acted_preceding` the actions columns 0..j-1 just took, so that a proximal column's
+  error reaches the distal modules' errors; module j's preceding actuation must then be modules
+  0..j-1's actions in order, normalised alike (`softbench.data.View.module`'s are).
   """
   modules = windows.modules
   if len(forward_models) != len(modules):
@@ -132,8 +138,11 @@ def joint_rollout(
     ]
     actions, state = network.step_columns(inputs, state, len(modules) - 1)
     for j, (w, model, action) in enumerate(zip(modules, forward_models, actions)):
+      actuation = (
+        torch.cat([*actions[:j], action], dim=-1) if acted_preceding else w.actuation(action, t)
+      )
       predicted, forward_states[j] = model.step(
-        w.previous_poses[:, t], w.current_poses[:, t], w.actuation(action, t), forward_states[j]
+        w.previous_poses[:, t], w.current_poses[:, t], actuation, forward_states[j]
       )
       history[j][0].append(action)
       history[j][1].append(errors[j])

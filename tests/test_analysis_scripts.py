@@ -253,7 +253,11 @@ def test_smpl_joint_columns_trains_every_column_at_once_and_reads_the_record(
   out = run_script(
     "smpl_joint_columns", [*arguments, "--results", str(results)], monkeypatch, capsys
   )
-  (line,) = re.findall(r"^smpl joint columns tendon-2 tiny seed 0: .*$", out, re.MULTILINE)
+  (line,) = re.findall(
+    r"^smpl joint columns, recorded preceding actuation, tendon-2 tiny seed 0: .*$",
+    out,
+    re.MULTILINE,
+  )
   joint = re.search(r"circle position error ([0-9.]+) mm", line).group(1)
   recorded = f"{record['per_seed'][0]['position_mm']['mean']:.4f}"
   assert f"the record: {recorded} mm" in line
@@ -262,4 +266,12 @@ def test_smpl_joint_columns_trains_every_column_at_once_and_reads_the_record(
     learners.views(arm, per_module=True), True, None, hyperparameters.values("smpl", arm.name)
   )
   assert f"({sum(p.numel() for p in network.parameters()):,} parameters trained" in line
+  acted = run_script(
+    "smpl_joint_columns",
+    [*arguments, "--results", str(results), "--preceding", "acted"],
+    monkeypatch,
+    capsys,
+  )
+  (acted_line,) = re.findall(r"^smpl joint columns, acted preceding .*$", acted, re.MULTILINE)
+  assert re.search(r"position error ([0-9.]+) mm", acted_line).group(1) != joint
   assert joint != recorded  # Trained otherwise, so scored otherwise.

@@ -9,11 +9,14 @@ the same per-module forward models and closed-loop rollout, ``smpl.rollout.joint
 every column trainable at once on the mean action error over all modules, for up to as many
 epochs as the columns get together (the profile's epochs times the modules), and scores it
 closed loop in physics on --task beside the committed record of `softbench run`'s SMPL for the
-same seed (read from --results). Nothing is cached but the forward models.
+same seed (read from --results). With --preceding acted, module k's forward model reads the
+actions columns 1..k-1 just took instead of their modules' recorded actuation, so that in training
+a proximal column's mistakes move the distal modules as they do in physics. Nothing is cached but
+the forward models.
 
 Usage (the forward models train first if the data home lacks them):
   python docs/analysis/smpl_joint_columns.py --robot tendon-local-3 --profile default \
-      --seeds 0 1 2 --task spiral
+      --seeds 0 1 2 --task spiral [--preceding acted]
 """
 
 import argparse
@@ -36,11 +39,11 @@ from softbench.agents import learned
 from softbench.agents import learners
 
 
-def joint_loss(network, forwards) -> training.BatchLoss:
+def joint_loss(network, forwards, acted_preceding: bool) -> training.BatchLoss:
   """The mean over modules of each module's action MSE, every column acting together."""
 
   def loss(batch: smpl_windows.ModuleWindows) -> torch.Tensor:
-    results = rollout.joint_rollout(network, batch, forwards)
+    results = rollout.joint_rollout(network, batch, forwards, acted_preceding=acted_preceding)
     errors = [
       nn.functional.mse_loss(result.actions, module.actions)
       for result, module in zip(results, batch.modules)
@@ -48,6 +51,16 @@ def joint_loss(network, forwards) -> training.BatchLoss:
     return sum(errors[1:], errors[0]) / len(errors)
 
   return loss
+
+
+def check_preceding_is_proximal(windows: list) -> None:
+  """Module k's recorded preceding actuation is modules 1..k-1's actions, normalised alike, as
+  ``acted_preceding`` needs; raises otherwise."""
+  for index, split in enumerate(windows):
+    proximal = [earlier.train.actions for earlier in windows[:index]]
+    expected = torch.cat(proximal, dim=-1) if proximal else split.train.preceding_actions
+    if not torch.allclose(split.train.preceding_actions, expected, atol=1e-6):
+      raise ValueError(f"module {index + 1}'s preceding actuation is not modules 1..{index}'s")
 
 
 def recorded_score(folder: str, task: str, robot: str, profile: str, seed: int) -> str:
@@ -70,6 +83,13 @@ def main() -> None:
   parser.add_argument("--seeds", type=int, nargs="+", default=[0])
   parser.add_argument("--task", default="spiral")
   parser.add_argument("--results", default=str(leaderboard.DEFAULT_RESULTS))
+  parser.add_argument(
+    "--preceding",
+    choices=("recorded", "acted"),
+    default="recorded",
+    help="module k's forward model reads modules 1..k-1's recorded actuation (the paper's "
+    "design) or the actions their columns just took",
+  )
   args = parser.parse_args()
 
   arm, profile = robots.make(args.robot), profiles.get(args.profile)
@@ -79,6 +99,7 @@ def main() -> None:
   device = training.default_device()
   for seed in args.seeds:
     windows, forwards = learned.trained_forward_models(arm, views, seed, profile)
+    check_preceding_is_proximal(windows)
     with training.seeded(seed, torch.device("cpu")):
       network, _ = learned.untrained(views, True, None, params)
     network.requires_grad_(True)  # Adding a column froze the ones before it.
@@ -89,7 +110,12 @@ def main() -> None:
     split = lambda part: smpl_windows.ModuleWindows(tuple(getattr(w, part) for w in windows))
     started = time.perf_counter()
     result = training.fit(
-      network, joint_loss(network, forwards), split("train"), split("validation"), config, device
+      network,
+      joint_loss(network, forwards, args.preceding == "acted"),
+      split("train"),
+      split("validation"),
+      config,
+      device,
     )
     trained_s = time.perf_counter() - started
     trained = sum(p.numel() for p in network.parameters() if p.requires_grad)
@@ -102,7 +128,8 @@ def main() -> None:
     position = entry["position_mm"]
     recorded = recorded_score(args.results, args.task, args.robot, args.profile, seed)
     print(
-      f"smpl joint columns {args.robot} {args.profile} seed {seed}: validation loss "
+      f"smpl joint columns, {args.preceding} preceding actuation, {args.robot} {args.profile} "
+      f"seed {seed}: validation loss "
       f"{result.best_validation_loss:.5f} after {result.epochs_run} epochs; {args.task} "
       f"position error {position['mean']:.4f} mm, per module "
       f"{[round(x, 3) for x in position['per_module']]} ({trained:,} parameters trained in "

@@ -146,3 +146,22 @@ def test_retraining_refuses_other_unfrozen_columns_and_a_missing_column(modules)
 def test_module_windows_must_be_aligned(make_arm_windows) -> None:
   with pytest.raises(ValueError, match="not aligned"):
     ModuleWindows((make_arm_windows(60, 4, seed=0), make_arm_windows(50, 3, seed=1)))
+
+
+@pytest.mark.parametrize("acted", [False, True])
+def test_acted_preceding_feeds_module_2_the_proximal_column_s_actions(make_arm_windows, acted):
+  """Module 2's forward model reads module 1's actuation: the recorded one by default, with
+  acted_preceding the actions column 1 just took (then the recorded one is not read)."""
+  first = make_arm_windows(60, ACTIONS[0], seed=0, arm_seed=0)
+  second = make_arm_windows(60, ACTIONS[1], seed=1, arm_seed=1)
+  network = _network()
+  torch.manual_seed(1)
+  forwards = [ForwardModel(size, hidden_size=8).freeze() for size in (ACTIONS[0], sum(ACTIONS))]
+
+  def module_2_errors(preceding: torch.Tensor) -> torch.Tensor:
+    windows = ModuleWindows((first, type(second)(second.poses, second.actions, preceding)))
+    with torch.no_grad():
+      return joint_rollout(network, windows, forwards, acted_preceding=acted)[1].errors
+
+  recorded = module_2_errors(first.actions)
+  assert torch.equal(recorded, module_2_errors(first.actions + 0.5)) == acted
