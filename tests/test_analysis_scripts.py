@@ -36,6 +36,16 @@ def run_script(name: str, arguments: list[str], monkeypatch, capsys) -> str:
   return capsys.readouterr().out
 
 
+def _smpl_circle_record() -> dict:
+  """`softbench run`'s record of SMPL on tendon-2's circle, tiny profile, seed 0: what the SMPL
+  analysis scripts must reproduce with SMPL's own settings."""
+  return run.execute(
+    run.settings("circle", "smpl", "tendon-2", seeds=1, profile="tiny"),
+    show_progress=False,
+    workers=1,
+  )
+
+
 def test_action_identifiability_reports_every_module_in_both_views(monkeypatch, capsys):
   data.collect("tendon-2", samples=200, seed=0, progress=False)
   out = run_script("action_identifiability", ["tendon-2", "--samples", "200"], monkeypatch, capsys)
@@ -210,11 +220,7 @@ def test_smpl_width_reproduces_smpl_at_the_papers_size_and_trains_other_sizes(mo
   )
   scores = dict(re.findall(r"^smpl (\d+x\d) .* position error ([0-9.]+) mm", out, re.MULTILINE))
   assert set(scores) == {"32x2", "16x1"}
-  record = run.execute(
-    run.settings("circle", "smpl", "tendon-2", seeds=1, profile="tiny"),
-    show_progress=False,
-    workers=1,
-  )
+  record = _smpl_circle_record()
   assert scores["32x2"] == f"{record['per_seed'][0]['position_mm']['mean']:.4f}"
   assert scores["16x1"] != scores["32x2"]
 
@@ -230,11 +236,7 @@ def test_smpl_forward_views_reproduces_smpl_and_trains_through_every_actuation(m
     re.findall(r"^smpl forward views (\w+) .* position error ([0-9.]+) mm", out, re.MULTILINE)
   )
   assert set(scores) == {"own", "every"}
-  record = run.execute(
-    run.settings("circle", "smpl", "tendon-2", seeds=1, profile="tiny"),
-    show_progress=False,
-    workers=1,
-  )
+  record = _smpl_circle_record()
   assert scores["own"] == f"{record['per_seed'][0]['position_mm']['mean']:.4f}"
   assert scores["every"] != scores["own"]
 
@@ -243,11 +245,7 @@ def test_smpl_joint_columns_trains_every_column_at_once_and_reads_the_record(
   monkeypatch, capsys, tmp_path
 ):
   results = tmp_path / "results"
-  record = run.execute(
-    run.settings("circle", "smpl", "tendon-2", seeds=1, profile="tiny"),
-    show_progress=False,
-    workers=1,
-  )
+  record = _smpl_circle_record()
   records.write(record, results / "smpl.json")
   arguments = ["--robot", "tendon-2", "--profile", "tiny", "--task", "circle"]
   out = run_script(
