@@ -493,14 +493,7 @@ def train_column_jointly(
   for model in forward_models:
     model.to(device).eval()
 
-  def loss(windows: ModuleWindows) -> Tensor:
-    results = joint_rollout(network, windows, forward_models, config.feed_back_error)
-    losses = [
-      nn.functional.mse_loss(results[index].actions, windows.modules[index].actions)
-      for index in range(column, last + 1)
-    ]
-    return sum(losses[1:], losses[0]) / len(losses)
-
+  loss = joint_action_loss(network, forward_models, column, config.feed_back_error)
   zero_action_loss = (
     _zero_action_loss([w.actions for w in validation.modules[column:]])
     if restart_diverged
@@ -509,6 +502,27 @@ def train_column_jointly(
   return _fit_restarting(
     network, loss, train, validation, config, device, on_epoch_end, None, zero_action_loss
   )
+
+
+def joint_action_loss(
+  network: ProgressiveLSTM,
+  forward_models: Sequence[ForwardModel],
+  first: int = 0,
+  feed_back_error: bool = True,
+  acted_preceding: bool = False,
+) -> BatchLoss:
+  """The batch loss of columns acting together (`smpl.rollout.joint_rollout`): the mean over
+  modules `first`..M-1 of each module's action MSE."""
+
+  def loss(windows: ModuleWindows) -> Tensor:
+    results = joint_rollout(network, windows, forward_models, feed_back_error, acted_preceding)
+    losses = [
+      nn.functional.mse_loss(results[index].actions, windows.modules[index].actions)
+      for index in range(first, len(windows.modules))
+    ]
+    return sum(losses[1:], losses[0]) / len(losses)
+
+  return loss
 
 
 def _zero_action_loss(actions: Sequence[Tensor]) -> float:

@@ -24,9 +24,7 @@ import dataclasses
 import time
 
 import torch
-from torch import nn
 
-from smpl import rollout
 from smpl import training
 from smpl import windows as smpl_windows
 from softbench import leaderboard
@@ -37,20 +35,6 @@ from softbench import run
 from softbench.agents import hyperparameters
 from softbench.agents import learned
 from softbench.agents import learners
-
-
-def joint_loss(network, forwards, acted_preceding: bool) -> training.BatchLoss:
-  """The mean over modules of each module's action MSE, every column acting together."""
-
-  def loss(batch: smpl_windows.ModuleWindows) -> torch.Tensor:
-    results = rollout.joint_rollout(network, batch, forwards, acted_preceding=acted_preceding)
-    errors = [
-      nn.functional.mse_loss(result.actions, module.actions)
-      for result, module in zip(results, batch.modules)
-    ]
-    return sum(errors[1:], errors[0]) / len(errors)
-
-  return loss
 
 
 def check_preceding_is_proximal(windows: list) -> None:
@@ -111,7 +95,12 @@ def main() -> None:
     started = time.perf_counter()
     result = training.fit(
       network,
-      joint_loss(network, forwards, args.preceding == "acted"),
+      training.joint_action_loss(
+        network,
+        forwards,
+        feed_back_error=config.feed_back_error,
+        acted_preceding=args.preceding == "acted",
+      ),
       split("train"),
       split("validation"),
       config,
