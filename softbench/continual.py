@@ -249,12 +249,12 @@ def build(
   network, forwards, normalisations = models.inverse, models.forwards, models.normalisations
   matrices = models.arrays
   network.eval()
-  controllers = [
-    learned.Controller(view, forward.eval(), scale)
-    for view, forward, scale in zip(views, forwards, normalisations)
-  ]
   return Exp1sModel(
-    network, controllers, arms, matrices["forgetting/pose_mse"], matrices["forgetting/action_mse"]
+    network,
+    learned.controllers(views, forwards, normalisations),
+    arms,
+    matrices["forgetting/pose_mse"],
+    matrices["forgetting/action_mse"],
   )
 
 

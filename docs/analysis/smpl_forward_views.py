@@ -56,10 +56,7 @@ def main() -> None:
         views, windows, forwards, seed, profile, True, None, params
       )
       trained_s = time.perf_counter() - started
-      controllers = [
-        learned.Controller(view, forward.eval(), split.normalisation)
-        for view, forward, split in zip(views, forwards, windows)
-      ]
+      controllers = learned.controllers(views, forwards, [split.normalisation for split in windows])
       agent = learned.LearnedAgent(arm, seed, inverse.eval(), controllers)
       entry, _ = run.evaluate(agent, arm, settings, seed)
       position = entry["position_mm"]

@@ -108,10 +108,7 @@ def main() -> None:
     )
     trained_s = time.perf_counter() - started
     trained = sum(p.numel() for p in network.parameters() if p.requires_grad)
-    controllers = [
-      learned.Controller(view, forward.cpu().eval(), part.normalisation)
-      for view, forward, part in zip(views, forwards, windows)
-    ]
+    controllers = learned.controllers(views, forwards, [part.normalisation for part in windows])
     agent = learned.LearnedAgent(arm, seed, network.cpu().eval(), controllers)
     entry, _ = run.evaluate(agent, arm, settings, seed)
     position = entry["position_mm"]

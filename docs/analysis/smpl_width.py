@@ -58,10 +58,7 @@ def main() -> None:
       )
     trained_s = time.perf_counter() - started
     inverse.eval()
-    controllers = [
-      learned.Controller(view, forward.eval(), split.normalisation)
-      for view, forward, split in zip(views, forwards, windows)
-    ]
+    controllers = learned.controllers(views, forwards, [split.normalisation for split in windows])
     agent = learned.LearnedAgent(arm, args.seed, inverse, controllers)
     entry, _ = run.evaluate(agent, arm, settings, args.seed)
     position = entry["position_mm"]

@@ -110,6 +110,19 @@ class Controller:
   forward_state: object = None
 
 
+def controllers(
+  views: list[data.View],
+  forwards: list[smpl_forward.ForwardModel],
+  normalisations: list[data.Normalisation],
+) -> list[Controller]:
+  """Each view's controller: its forward model (on the CPU, where agents act, in eval mode) and
+  normalisation."""
+  return [
+    Controller(view, forward.cpu().eval(), scale)
+    for view, forward, scale in zip(views, forwards, normalisations)
+  ]
+
+
 class LearnedAgent(base.Agent):
   """Acts with trained controllers; see the module docstring.
 
@@ -674,12 +687,12 @@ def build_agent(
   )
   inverse, forwards, normalisations = models.inverse, models.forwards, models.normalisations
   inverse.eval()
-  controllers = [
-    Controller(view, forward.eval(), scale)
-    for view, forward, scale in zip(views, forwards, normalisations)
-  ]
   return LearnedAgent(
-    robot, seed, inverse, controllers, candidates=lambda: babbling_candidates(robot, profile)
+    robot,
+    seed,
+    inverse,
+    controllers(views, forwards, normalisations),
+    candidates=lambda: babbling_candidates(robot, profile),
   )
 
 
