@@ -257,6 +257,7 @@ def _sweep(args: argparse.Namespace) -> None:
     args.address,
     args.data_home,
     families=(args.families or [continual.DEFAULT_FAMILY]) if args.protocol else (),
+    dry_run=args.dry_run,
   )
 
 
@@ -534,6 +535,11 @@ def build_parser() -> argparse.ArgumentParser:
     "(default: $SOFTBENCH_HOME)",
   )
   _add_results_argument(sweep_parser)
+  sweep_parser.add_argument(
+    "--dry-run",
+    action="store_true",
+    help="print the settings that have no record yet and what they need built; run nothing",
+  )
   sweep_parser.set_defaults(run=_sweep)
 
   board_parser = commands.add_parser(

@@ -13,6 +13,7 @@ import signal
 import threading
 import time
 
+from handmade_exp1s import exp1s_record
 import pytest
 import ray
 from ray import cluster_utils
@@ -27,6 +28,7 @@ from softbench import run
 from softbench import storage
 from softbench import sweep
 from softbench import zoo
+from softbench.agents import learned
 from softbench.sweep import display
 from softbench.sweep import grid as sweep_grid
 
@@ -259,10 +261,60 @@ def test_an_address_where_no_cluster_answers_is_one_line(tmp_path):
   assert not ray.is_initialized()
 
 
+def test_a_record_stands_for_its_setting_only_with_its_seeds_and_target_completion(
+  expected, tmp_path
+):
+  results, name = tmp_path / "results", "mlp-tendon-1-reach-tiny-physics"
+  results.mkdir()
+  reach = dataclasses.replace(GRID, tasks=("reach",), agents=("mlp",))
+  made = expected[name]
+  assert made["seeds"] == 2 and made["helpers"] == learned.DEFAULT_HELPER_TARGETS
+  held = {**made, "helpers": "hold"}  # As a reach made before target completion, or --helpers hold.
+  one_seed = {
+    **made,
+    "seeds": 1,
+    "per_seed": made["per_seed"][:1],
+    "weights": {"per_seed": made["weights"]["per_seed"][:1]},
+  }
+  for day, record in ((1, held), (2, one_seed)):
+    records.write(record, results / f"{name}-2026-11-0{day}T000000Z.json")
+  assert sweep_grid.plan(reach, results).skipped == ()
+  damaged = results / f"{name}-2026-11-03T000000Z.json"
+  damaged.write_text("{")
+  with pytest.raises(records.RecordError, match=f"{damaged}: not valid JSON") as raised:
+    sweep_grid.plan(reach, results)
+  assert "\n" not in str(raised.value)
+  records.write(made, damaged)
+  assert sweep_grid.plan(reach, results).skipped == (damaged,)
+
+
+def test_a_dry_run_lists_the_settings_without_records_and_runs_nothing(expected, tmp_path, capsys):
+  results, name = tmp_path / "results", "mlp-tendon-1-circle-tiny-physics"
+  argv = ["sweep", "--robots", "tendon-1", "--tasks", "circle", "--agents", "zero", "mlp"]
+  argv += ["--profile", "tiny", "--seeds", "2", "--results", str(results), "--dry-run"]
+  assert cli.main(argv) == 0
+  assert capsys.readouterr().out.splitlines() == [
+    "2 settings to run, 0 with records skipped",
+    "  zero-tendon-1-circle-tiny-physics: 2 of 2 seeds",
+    "  mlp-tendon-1-circle-tiny-physics: 2 of 2 seeds",
+    "to build: dataset 1, forward 2, agent 2, network 0; found in the data home: 0",
+  ]
+  assert not ray.is_initialized() and not list(results.glob("*"))
+  assert not list(storage.softbench_home().glob("*/*"))  # Nothing built.
+  records.write(expected[name], results / f"{name}-2026-11-24T000000Z.json")
+  assert cli.main(argv) == 0
+  assert capsys.readouterr().out.splitlines()[:2] == [
+    "1 settings to run, 1 with records skipped",
+    "  zero-tendon-1-circle-tiny-physics: 2 of 2 seeds",
+  ]
+
+
 def test_an_exp1s_record_stands_for_its_own_family_only(tmp_path):
   results = tmp_path / "results"
   results.mkdir()
-  (results / "smpl-exp1s-tiny-2026-11-24T000000Z.json").touch()  # The tendon family's.
+  records.write(  # The tendon family's.
+    exp1s_record(seeds=1), results / "smpl-exp1s-tiny-2026-11-24T000000Z.json"
+  )
   work = sweep_grid.plan(
     sweep.Grid((), (), (), "tiny", 1, families=("tendon", "tendon-local")), results
   )

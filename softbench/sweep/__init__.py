@@ -68,13 +68,15 @@ def sweep(
   data_home: str | os.PathLike | None = None,
   show_progress: bool = True,
   families: Sequence[str] = (),
+  dry_run: bool = False,
 ) -> SweepResult:
   """Runs every setting of the grid that ``results`` has no record of, as Ray tasks: on the
   cluster at ``address`` (``HOST:PORT``), else on a local Ray with one worker per core (or the
   Ray this process already started); ``data_home`` replaces ``$SOFTBENCH_HOME`` for the driver
   and every worker (docs/sweep.md: what to share). ``families``: also Exp1S on each of these
   tendon families (``softbench run --protocol exp1s --family F``); with families, the robots,
-  tasks and agents may all be empty.
+  tasks and agents may all be empty. ``dry_run``: print what would run and build
+  (``Plan.report``) and run nothing (zoo checkpoints the grid needs are taken, as a sweep would).
 
   Raises:
     ValueError: an unknown robot, task, agent, family, profile or eval mode, seeds < 1, an
@@ -90,6 +92,9 @@ def sweep(
     storage.check_home()
     folder = storage.check_writable(results, "results folder", folder=True)
     work = plan(grid, folder)
+    if dry_run:
+      print(work.report())
+      return SweepResult((), work.skipped)
     if work.skipped:
       print(f"sweep: {len(work.skipped)} settings have records already, skipped", file=sys.stderr)
     if work.resumed:

@@ -1,8 +1,9 @@
 """A sweep's grid and the graph of work behind it, planned in the driver before Ray starts.
 
 Every setting of the grid (robot x task x agent x eval mode, one profile and seed count) is a
-``run.RunSettings``; one that already has a record of its profile in the results folder is
-skipped, as ``make leaderboard`` skips it. Each seed of the others is an ``Evaluation``, unless
+``run.RunSettings``; one that already has a record of its profile, seeds and target
+completion in the results folder is skipped (``existing_record``), as ``make leaderboard`` skips
+it. Each seed of the others is an ``Evaluation``, unless
 an interrupted run or sweep kept its episode (``episode_snapshots``). An evaluation of a learned
 agent needs the ``Build`` of that agent for its robot, seed and profile, shared by every task and
 eval mode; an agent trained on babbling needs the forward model of each view it reads (shared by
@@ -25,6 +26,7 @@ from softbench import agents
 from softbench import continual
 from softbench import episodes
 from softbench import profiles
+from softbench import records
 from softbench import robots
 from softbench import run as run_module
 from softbench import storage
@@ -134,6 +136,19 @@ class Plan:
   found: frozenset[Build]
   taken: dict[Setting, list[str]]
 
+  def report(self) -> str:
+    """What the sweep would do, a line per setting to run, as ``softbench sweep --dry-run``
+    prints it."""
+    lines = [f"{len(self.settings)} settings to run, {len(self.skipped)} with records skipped"]
+    for run in self.settings:
+      resumed = sum((run, seed) in self.resumed for seed in range(run.seeds))
+      kept = f", {resumed} resumed from kept episodes" if resumed else ""
+      lines.append(f"  {setting_name(run)}: {run.seeds - resumed} of {run.seeds} seeds{kept}")
+    to_build = [build for build in self.builds if build not in self.found]
+    counts = ", ".join(f"{kind} {sum(build.kind == kind for build in to_build)}" for kind in KINDS)
+    lines.append(f"to build: {counts}; found in the data home: {len(self.found)}")
+    return "\n".join(lines)
+
 
 def setting_name(run: Setting) -> str:
   """``agent-robot-task-profile-eval``, as its record's file name begins; of an Exp1S run,
@@ -144,9 +159,27 @@ def setting_name(run: Setting) -> str:
 
 
 def existing_record(run: Setting, results: pathlib.Path) -> pathlib.Path | None:
-  """A record of ``run``'s setting in ``results`` (any date): a file named ``setting_name``, then
-  a date, as ``run.record_path`` (or ``continual.record_path``) names it; None if there is none."""
-  return next(iter(sorted(results.glob(f"{setting_name(run)}-*.json"))), None)
+  """The oldest record of ``run``'s setting in ``results``: a file named ``setting_name``, then a
+  date, as ``run.record_path`` (or ``continual.record_path``) names it, that holds as many seeds
+  and, for a task, completed partial targets the same way (``helpers``; a record without any
+  did not complete them); None if there is none.
+
+  Raises:
+    records.RecordError: such a file is not a valid, untouched record (one line).
+  """
+  wanted = _unnamed_settings(run)
+  for path in sorted(results.glob(f"{setting_name(run)}-*.json")):
+    record = records.read(path)
+    if {field: record.get(field) for field in wanted} == wanted:
+      return path
+  return None
+
+
+def _unnamed_settings(run: Setting) -> dict:
+  """The settings of ``run`` that its record holds but its file name does not say."""
+  if isinstance(run, continual.RunSettings):
+    return {"seeds": run.seeds}
+  return {"seeds": run.seeds, "helpers": run.helpers}
 
 
 def _relative(path: pathlib.Path) -> str:
