@@ -36,6 +36,7 @@ from softbench import evaluation
 from softbench import metrics
 from softbench import parallel_seeds
 from softbench import profiles
+from softbench import progress as progress_bars
 from softbench import protocols
 from softbench import robots
 from softbench import storage
@@ -189,7 +190,7 @@ def _train(seed: int, profile: profiles.Profile, show: bool, family: str):
   forward_config, inverse_config = learned.training_configs(
     seed, profile, _params(sequence.robot_names[-1])
   )
-  progress_bars = lambda label: learned.progress_bar(
+  epoch_bars = lambda label: progress_bars.epochs(
     f"{label} ({PROTOCOL} seed {seed})", profile.max_epochs, show
   )
   result = protocols.run(
@@ -200,7 +201,7 @@ def _train(seed: int, profile: profiles.Profile, show: bool, family: str):
     inverse_config,
     training.default_device(),
     show,
-    progress_bars,
+    epoch_bars,
   )
   result.network.requires_grad_(False)
   return (

@@ -44,14 +44,28 @@ def sigterm_as_interrupt() -> Iterator[None]:
     signal.signal(signal.SIGTERM, previous)
 
 
-def _init_worker() -> None:
+def _init_worker(states) -> None:
   """Worker initialiser: one torch thread (the workers fill the cores; torch's default, one thread
   per core in every worker, made a BiLSTM's evaluation step 450 times slower, 930 ms against 2 ms,
   with the cores busy); Ctrl-C reaches the parent only, which stops the workers itself; warnings
-  print as in the parent."""
+  print as in the parent; progress bars send their states to the parent's ``states`` queue."""
   torch.set_num_threads(training.CPU_THREADS)
   signal.signal(signal.SIGINT, signal.SIG_IGN)
   one_line_warnings()
+  progress_bars.relay_to(states)
+
+
+def _show_worker_states(states, progress, bars: dict) -> None:
+  """Shows the states the workers' bars sent (``progress.relay_to``): a bar per worker, showing
+  the work that worker last reported on, restarted (elapsed time too) when that work changes."""
+  while not states.empty():
+    worker, description, completed, total = states.get()
+    if worker not in bars:
+      bars[worker] = progress.add_task(description, total=total), description
+    elif bars[worker][1] != description:
+      bars[worker] = bars[worker][0], description
+      progress.reset(bars[worker][0], total=total, description=description)
+    progress.update(bars[worker][0], completed=completed, total=total)
 
 
 class WorkerDied(RuntimeError):
@@ -60,7 +74,8 @@ class WorkerDied(RuntimeError):
 
 def in_processes(function, arguments: list[tuple], label: str, workers: int) -> list:
   """``function(*args)`` for each entry of ``arguments`` in ``workers`` processes (one torch and
-  MuJoCo thread each), with one progress bar; results in order.
+  MuJoCo thread each), with a progress bar of the entries done and one per worker of the work it
+  is on (its own bars, relayed); results in order.
 
   A worker's exception is raised here. On Ctrl-C, or when a worker dies, the workers are
   terminated; seeds whose checkpoints were written are reused by the next run.
@@ -68,18 +83,25 @@ def in_processes(function, arguments: list[tuple], label: str, workers: int) -> 
   Raises:
     WorkerDied: a worker process ended without a result.
   """
-  progress = progress_bars.counting()
+  progress, context, worker_bars = (
+    progress_bars.counting(),
+    multiprocessing.get_context("spawn"),
+    {},
+  )
+  states = context.SimpleQueue()  # Written at once (no feeder thread): read before the results.
   executor = futures.ProcessPoolExecutor(
-    workers, multiprocessing.get_context("spawn"), initializer=_init_worker
+    workers, context, initializer=_init_worker, initargs=(states,)
   )
   try:
     with progress:
       bar = progress.add_task(f"{label} ({workers} processes)", total=len(arguments))
       pending = [executor.submit(function, *entry) for entry in arguments]
       while futures.wait(pending, _POLL_SECONDS, futures.FIRST_EXCEPTION).not_done:
+        _show_worker_states(states, progress, worker_bars)
         progress.update(bar, completed=sum(future.done() for future in pending))
         if any(future.done() and future.exception() for future in pending):
           break
+      _show_worker_states(states, progress, worker_bars)
       outcomes = [future.result() for future in pending]  # Re-raises a worker's error.
       progress.update(bar, completed=len(arguments))
   except futures.process.BrokenProcessPool:

@@ -2,14 +2,28 @@
 
 rich draws no bars on an output that is not a terminal (a log file of a job in the background)
 until the work ends; there a bar also writes a line of its state at most every
-``LOG_INTERVAL_S``."""
+``LOG_INTERVAL_S``. In a seed worker (``parallel_seeds``), whose bars are not shown, every bar
+sends its state to the parent instead (``relay_to``), which shows a bar per worker."""
 
+import contextlib
 import datetime
+import os
 import time
 
 from rich import progress as rich_progress
 
 LOG_INTERVAL_S = 60.0  # (s) Least time between two lines of one bar written to a log.
+RELAY_INTERVAL_S = 0.5  # (s) Least time between two states of one bar sent to the parent.
+
+_relay = None  # Where this process's bars send their states (a seed worker's queue), or None.
+
+
+def relay_to(queue) -> None:
+  """From now on, every bar of this process, shown or not, puts its state on ``queue`` (a
+  multiprocessing ``SimpleQueue``) as ``(process id, description, completed, total)``: at most
+  every ``RELAY_INTERVAL_S`` per bar, and when the bar completes."""
+  global _relay  # pylint: disable=global-statement
+  _relay = queue
 
 
 class _Progress(rich_progress.Progress):
@@ -19,14 +33,28 @@ class _Progress(rich_progress.Progress):
   def __init__(self, *columns: rich_progress.ProgressColumn, **options) -> None:
     super().__init__(*columns, **options)
     self._logged_at: dict[rich_progress.TaskID, float] = {}
+    self._relayed_at: dict[rich_progress.TaskID, float] = {}
 
   def update(self, task_id: rich_progress.TaskID, **changes) -> None:
     super().update(task_id, **changes)
     self._log(task_id)
+    self._relay(task_id)
 
   def advance(self, task_id: rich_progress.TaskID, advance: float = 1) -> None:
     super().advance(task_id, advance)
     self._log(task_id)
+    self._relay(task_id)
+
+  def _relay(self, task_id: rich_progress.TaskID) -> None:
+    if _relay is None:
+      return
+    now = time.monotonic()
+    recent = now - self._relayed_at.get(task_id, -RELAY_INTERVAL_S) < RELAY_INTERVAL_S
+    (task,) = [task for task in self.tasks if task.id == task_id]
+    if recent and not task.finished:
+      return
+    self._relayed_at[task_id] = now
+    _relay.put((os.getpid(), task.description, task.completed, task.total))
 
   def _log(self, task_id: rich_progress.TaskID) -> None:
     if self.disable or self.console.is_terminal:
@@ -39,6 +67,38 @@ class _Progress(rich_progress.Progress):
     elapsed = datetime.timedelta(seconds=round(task.elapsed or 0.0))
     total = "?" if task.total is None else f"{task.total:g}"
     self.console.print(f"{task.description}: {task.completed:g}/{total}, {elapsed} elapsed")
+
+
+class _RelayedEpochs:
+  """An epoch callback of ``smpl.training`` (a context manager) whose bar is not drawn but relayed
+  (``relay_to``): the epochs done, complete when training ends (early stopping included)."""
+
+  def __init__(self, label: str, max_epochs: int) -> None:
+    self._progress = counting(show=False)
+    self._task = self._progress.add_task(label, total=max_epochs)
+
+  def __enter__(self) -> "_RelayedEpochs":
+    return self
+
+  def __exit__(self, *exception) -> None:
+    (task,) = self._progress.tasks
+    self._progress.update(self._task, total=task.completed or 1, completed=task.completed or 1)
+
+  def __call__(self, report) -> None:
+    self._progress.update(self._task, completed=report.epoch + 1)
+
+
+def epochs(label: str | None, max_epochs: int, show: bool):
+  """The epoch progress bar of a training named ``label`` (a context manager giving the callback
+  ``smpl.training`` takes, or None): drawn if ``show`` (``smpl.progress.EpochProgressBar``), else
+  relayed in a seed worker (``relay_to``); none if ``label`` is None or nothing would show it."""
+  if label is None or not (show or _relay is not None):
+    return contextlib.nullcontext(None)
+  if not show:
+    return _RelayedEpochs(label, max_epochs)
+  from smpl import progress as epoch_progress  # Here: it imports torch, which listings need not.
+
+  return epoch_progress.EpochProgressBar(label, max_epochs)
 
 
 def counting(

@@ -13,6 +13,7 @@ import pytest
 import torch
 
 from softbench import parallel_seeds
+from softbench import progress
 
 CHILD_DEADLINE_S = 60  # (s) A child program still running after this has hung.
 
@@ -45,6 +46,24 @@ def test_results_come_back_in_order_from_workers_of_one_torch_thread():
     torch.set_num_threads(before)
 
 
+def count_with_a_hidden_bar(value):
+  with progress.counting(show=False) as bars:  # As a seed's training in a worker draws it.
+    bar = bars.add_task(f"counting to {value}", total=value)
+    for _ in range(value):
+      bars.advance(bar)
+  return value
+
+
+def test_each_worker_shows_the_bars_it_does_not_draw_itself(monkeypatch, capsys):
+  monkeypatch.setattr(progress, "LOG_INTERVAL_S", 0.0)  # Every state a line (not a terminal).
+  assert parallel_seeds.in_processes(
+    count_with_a_hidden_bar, [(3,), (4,)], "counting", workers=2
+  ) == [3, 4]
+  lines = capsys.readouterr().out.splitlines()
+  for value in (3, 4):  # Its last state, sent when it completed.
+    assert any(line.startswith(f"counting to {value}: {value}/{value}, ") for line in lines)
+
+
 def test_a_worker_error_is_raised():
   with pytest.raises(ValueError, match="bad seed"):
     parallel_seeds.in_processes(fail, [(1,), (2,)], "failing", workers=2)
@@ -54,6 +73,7 @@ _DYING_PROGRAM = """
 import sys
 sys.path.insert(0, {tests!r})
 from softbench import parallel_seeds
+from softbench import progress
 import test_parallel_seeds
 try:
   parallel_seeds.in_processes(test_parallel_seeds.die, [(1,), (2,)], "dying", workers=2)
@@ -78,6 +98,7 @@ import signal, sys, time
 signal.signal(signal.SIGINT, signal.default_int_handler)
 sys.path.insert(0, {tests!r})
 from softbench import parallel_seeds
+from softbench import progress
 import test_parallel_seeds
 try:
   with parallel_seeds.sigterm_as_interrupt():  # As softbench.cli.main runs every command.
@@ -115,6 +136,7 @@ _SEMAPHORE_PROGRAM = """
 import sys
 sys.path.insert(0, {tests!r})
 from softbench import parallel_seeds
+from softbench import progress
 import test_parallel_seeds
 print(parallel_seeds.in_processes(test_parallel_seeds.doubled_holding_a_semaphore,
                                   [(1.0,), (2.0,)], "holding", workers=1))

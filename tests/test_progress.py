@@ -1,6 +1,10 @@
 """Progress bars on an output that is not a terminal (a log file), where rich draws nothing until
-the work ends: each bar writes a line of its state at most every ``progress.LOG_INTERVAL_S``."""
+the work ends: each bar writes a line of its state at most every ``progress.LOG_INTERVAL_S``; in a
+seed worker, hidden bars send their states to the parent."""
 
+import collections
+import os
+import queue
 import re
 
 from softbench import progress
@@ -34,3 +38,31 @@ def test_a_hidden_bar_writes_nothing(capsys, monkeypatch):
   with progress.counting(show=False) as bars:
     bars.update(bars.add_task("seeds", total=5), completed=1)
   assert capsys.readouterr().out == ""
+
+
+def _relayed(states: queue.SimpleQueue) -> list[tuple]:
+  sent = []
+  while not states.empty():
+    worker, *state = states.get()
+    assert worker == os.getpid()
+    sent.append(tuple(state))
+  return sent
+
+
+def test_in_a_seed_worker_a_hidden_bar_sends_its_state_at_most_every_interval(monkeypatch):
+  states = queue.SimpleQueue()
+  monkeypatch.setattr(progress, "_relay", states)  # As parallel_seeds' workers start.
+  monkeypatch.setattr(progress, "RELAY_INTERVAL_S", 3600.0)
+  with progress.counting(show=False) as bars:
+    bar = bars.add_task("episode", total=3)
+    for _ in range(3):
+      bars.advance(bar)
+  assert _relayed(states) == [("episode", 1, 3), ("episode", 3, 3)]  # The first, then complete.
+  report = collections.namedtuple("Report", "epoch")
+  with progress.epochs("forward tendon-1", 800, show=False) as on_epoch_end:
+    for epoch in range(5):  # Early stopping after 5 of 800 epochs.
+      on_epoch_end(report(epoch))
+  assert _relayed(states) == [("forward tendon-1", 1, 800), ("forward tendon-1", 5, 5)]
+  monkeypatch.setattr(progress, "_relay", None)  # Not a worker: nothing to show it, no bar.
+  with progress.epochs("forward tendon-1", 800, show=False) as on_epoch_end:
+    assert on_epoch_end is None

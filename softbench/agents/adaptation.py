@@ -39,6 +39,7 @@ from smpl import training
 from smpl import windows as smpl_windows
 from softbench import data
 from softbench import profiles
+from softbench import progress as progress_bars
 from softbench import storage
 from softbench.agents import hyperparameters
 from softbench.agents import learned
@@ -213,7 +214,7 @@ def _retrain(
   for index in range(module - 1, len(forwards)):
     forwards[index].requires_grad_(True)
     bar_label = f"forward module-{index + 1} {label}"
-    with learned.progress_bar(bar_label, profile.max_epochs, show) as bar:
+    with progress_bars.epochs(bar_label, profile.max_epochs, show) as bar:
       training.train_forward_model(
         forwards[index],
         windows[index].train,
@@ -225,7 +226,7 @@ def _retrain(
   inverse.requires_grad_(False)
   inverse.columns[module - 1].requires_grad_(True)
   split = lambda name: smpl_windows.ModuleWindows(tuple(getattr(w, name) for w in windows))
-  with learned.progress_bar(f"inverse column {module} {label}", profile.max_epochs, show) as bar:
+  with progress_bars.epochs(f"inverse column {module} {label}", profile.max_epochs, show) as bar:
     training.train_column_jointly(
       inverse,
       forwards,

@@ -12,17 +12,16 @@ interrupted training resumes from its snapshots (``smpl.snapshots``, in the cach
 (``storage.read_cached``).
 """
 
-import contextlib
 import dataclasses
 import hashlib
 import pathlib
 
 from smpl import checkpoint
 from smpl import forward_model as smpl_forward
-from smpl import progress
 from smpl import snapshots
 from smpl import training
 from softbench import data
+from softbench import progress as progress_bars
 from softbench import protocols
 from softbench import storage
 from softbench import zoo
@@ -92,6 +91,7 @@ def prepare(
   config: training.ForwardTrainingConfig,
   training_version: int,
   progress_label: str | None = None,
+  show_progress: bool = False,
 ) -> tuple[list[data.SplitWindows], list[smpl_forward.ForwardModel]]:
   """Each view's windows of ``dataset`` (``samples`` babbling samples of seed ``data_seed``) and
   its frozen forward model trained with ``config``: from the cache, or trained now (with an epoch
@@ -106,10 +106,10 @@ def prepare(
     def train() -> tuple[data.SplitWindows, smpl_forward.ForwardModel]:
       with (
         snapshots.resumable(partial),
-        (
-          progress.EpochProgressBar(f"{progress_label} {view.name}", config.max_epochs)
-          if progress_label
-          else contextlib.nullcontext(None)
+        progress_bars.epochs(
+          None if progress_label is None else f"{progress_label} {view.name}",
+          config.max_epochs,
+          show_progress,
         ) as bar,
       ):
         column = protocols.prepare_column(

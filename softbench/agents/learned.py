@@ -36,7 +36,6 @@ which keeps comparisons fair (``softbench.adaptive``). With every module active 
 those of the unmasked agent, bit for bit.
 """
 
-import contextlib
 import dataclasses
 import hashlib
 import pathlib
@@ -47,7 +46,6 @@ import torch
 
 from smpl import checkpoint
 from smpl import forward_model as smpl_forward
-from smpl import progress
 from smpl import progressive
 from smpl import snapshots
 from smpl import training
@@ -55,6 +53,7 @@ from smpl import windows as smpl_windows
 from smpl.inverse import InverseModel
 from softbench import data
 from softbench import profiles
+from softbench import progress as progress_bars
 from softbench import storage
 from softbench import zoo
 from softbench.agents import base
@@ -383,11 +382,6 @@ def bundle(inverse: InverseModel, forwards: list[smpl_forward.ForwardModel]) -> 
   return torch.nn.ModuleDict({"inverse": inverse, "forward_models": torch.nn.ModuleList(forwards)})
 
 
-def progress_bar(label: str, epochs: int, show: bool):
-  """An epoch progress bar (a context manager), or a null context when ``show`` is false."""
-  return progress.EpochProgressBar(label, epochs) if show else contextlib.nullcontext(None)
-
-
 def _train(
   name: str,
   robot: robot_base.SoftArm,
@@ -411,7 +405,8 @@ def _train(
     per_module,
     make_model,
     params,
-    f"{name} {robot.name} seed {seed}" if show else None,
+    f"{name} {robot.name} seed {seed}",
+    show,
   )
   return inverse, forwards, [split.normalisation for split in windows]
 
@@ -435,7 +430,8 @@ def trained_forward_models(
     DATA_SEED,
     forward_config(seed, profile),
     TRAINING_VERSION,
-    f"forward {robot.name} seed {seed}" if show_progress else None,
+    f"forward {robot.name} seed {seed}",
+    show_progress,
   )
 
 
@@ -449,6 +445,7 @@ def train_inverse(
   make_model: ModelFactory | None,
   params: dict,
   progress_label: str | None = None,
+  show_progress: bool = False,
   on_epoch: EpochCallback | None = None,
   restart_diverged: bool = True,
 ) -> tuple[InverseModel, float]:
@@ -471,8 +468,8 @@ def train_inverse(
   action_sizes = [view.action_size for view in views]
   best_losses = []
   for index, view in enumerate(views):
-    label = f"inverse {progress_label} {view.name}"
-    with progress_bar(label, profile.max_epochs, progress_label is not None) as bar:
+    label = None if progress_label is None else f"inverse {progress_label} {view.name}"
+    with progress_bars.epochs(label, profile.max_epochs, show_progress) as bar:
       epoch_end = _epoch_callback(
         bar,
         on_epoch,

@@ -24,7 +24,8 @@ from softbench.sweep import shipping
 
 
 def _set_up() -> None:
-  """As ``parallel_seeds._init_worker``, except Ctrl-C, which the driver handles by cancelling."""
+  """As ``parallel_seeds._init_worker``, except Ctrl-C, which the driver handles by cancelling,
+  and progress bars: the sweep's display counts tasks."""
   torch.set_num_threads(training.CPU_THREADS)
   parallel_seeds.one_line_warnings()
 
