@@ -83,11 +83,8 @@ def in_processes(function, arguments: list[tuple], label: str, workers: int) -> 
   Raises:
     WorkerDied: a worker process ended without a result.
   """
-  progress, context, worker_bars = (
-    progress_bars.counting(),
-    multiprocessing.get_context("spawn"),
-    {},
-  )
+  progress, worker_bars = progress_bars.counting(), {}
+  context = multiprocessing.get_context("spawn")
   states = context.SimpleQueue()  # Written at once (no feeder thread): read before the results.
   executor = futures.ProcessPoolExecutor(
     workers, context, initializer=_init_worker, initargs=(states,)
