@@ -134,6 +134,43 @@ def load(run, seed: int) -> episodes.Episode | None:
   return storage.read_cached(_path(run, seed), read, "saved episode", f"seed {seed} runs again")
 
 
+def partial_path(run, seed: int) -> pathlib.Path:
+  """Where the unfinished episode of ``seed`` is kept while it runs (``save_partial``)."""
+  return folder(run) / f"unfinished-seed{seed}.npz"
+
+
+_AGENT_PREFIX = "agent_"  # Before the names of the agent's episode state in an unfinished episode.
+
+
+def save_partial(path: pathlib.Path, actions: list[np.ndarray], agent_state: dict) -> None:
+  """Keeps an unfinished episode at ``path``: the actions taken so far and the agent's episode
+  state after them (``Agent.episode_state``); a failed write only warns."""
+  arrays = {f"{_AGENT_PREFIX}{name}": np.asarray(value) for name, value in agent_state.items()}
+  arrays["actions"] = np.asarray(actions, dtype=float).reshape(len(actions), -1)
+  arrays["owner"] = np.asarray(_owner(path))
+  arrays["sha256"] = np.asarray(storage.arrays_sha256(arrays))
+  _keep(path, storage.npz_bytes(arrays), f"an unfinished episode ({len(actions)} steps)", "state")
+
+
+def load_partial(path: pathlib.Path) -> tuple[np.ndarray, dict] | None:
+  """The actions and agent state an interrupted episode kept at ``path`` (``save_partial``), or
+  None; an unreadable or altered file is deleted with a warning (the episode then starts again)."""
+
+  def read(found: pathlib.Path) -> tuple[np.ndarray, dict]:
+    arrays = dataset.read_npz(found.read_bytes(), ValueError)
+    if str(arrays.pop("sha256")) != storage.arrays_sha256(arrays):
+      raise ValueError("content hash mismatch")
+    _check_owner(str(arrays.pop("owner")), found)
+    state = {
+      name.removeprefix(_AGENT_PREFIX): value
+      for name, value in arrays.items()
+      if name.startswith(_AGENT_PREFIX)
+    }
+    return arrays["actions"], state
+
+  return storage.read_cached(path, read, "unfinished episode", "the episode starts again")
+
+
 def _scores_sha256(scores: dict) -> str:
   return hashlib.sha256(json.dumps(scores, sort_keys=True).encode()).hexdigest()
 

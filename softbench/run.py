@@ -274,16 +274,21 @@ def _seed_scores(score: metrics.TrackingScore) -> dict:
 
 
 def episode_on(
-  agent: agents.Agent, arm: robots.SoftArm, run: RunSettings, seed: int, show_progress: bool = False
+  agent: agents.Agent,
+  arm: robots.SoftArm,
+  run: RunSettings,
+  seed: int,
+  show_progress: bool = False,
+  unfinished: pathlib.Path | None = None,
 ) -> episodes.Episode:
   """One episode of ``run``'s task (environment seed ``seed``) by ``agent`` on ``arm``, which may
-  be a faulty robot."""
+  be a faulty robot; kept while it runs at ``unfinished`` (``evaluation.run_episode``)."""
   if isinstance(agent, learned.LearnedAgent):
     agent.error_source = run.eval_mode
     if run.helpers is not None:
       agent.helper_targets = run.helpers
   env = suite.load(arm, run.task, seed=seed, **task_options(run))
-  return evaluation.run_episode(env, agent, run.task, show_progress)
+  return evaluation.run_episode(env, agent, run.task, show_progress, unfinished)
 
 
 def seed_entry(seed: int, episode: episodes.Episode, arm: robots.SoftArm) -> dict:
@@ -311,13 +316,13 @@ def seed_episode(run: RunSettings, seed: int, show_progress: bool = False) -> ep
 
 
 def _episode_and_arm(
-  run: RunSettings, seed: int, show_progress: bool
+  run: RunSettings, seed: int, show_progress: bool, unfinished: pathlib.Path | None = None
 ) -> tuple[episodes.Episode, robots.SoftArm]:
   """``seed_episode``, and the (faulty) robot it ran on."""
   arm = robots.make(run.robot)
   agent = agents.make(run.agent, arm, seed, run.profile, show_progress)
   faulty = arm.with_faults(run.faults)
-  return episode_on(agent, faulty, run, seed, show_progress), faulty
+  return episode_on(agent, faulty, run, seed, show_progress, unfinished), faulty
 
 
 def score_seed(run: RunSettings, seed: int) -> dict:
@@ -339,8 +344,10 @@ def fresh_seed(
   run: RunSettings, seed: int, show_progress: bool = False
 ) -> tuple[dict, episodes.Episode]:
   """``seed_episode``'s record entry, checked to be finite (a record must hold it), and the
-  episode."""
-  episode, arm = _episode_and_arm(run, seed, show_progress)
+  episode; an episode of an agent that can resume one is kept while it runs
+  (``episode_snapshots.partial_path``), and an interrupted one goes on."""
+  unfinished = episode_snapshots.partial_path(run, seed)
+  episode, arm = _episode_and_arm(run, seed, show_progress, unfinished)
   entry = seed_entry(seed, episode, arm)
   records.check_finite(entry, f"seed {seed}'s scores")
   return entry, episode

@@ -1,14 +1,21 @@
 """An interrupted ``softbench run`` resumes: finished seeds are kept and not run again, with the
-same record as an uninterrupted run; a damaged saved seed runs again."""
+same record as an uninterrupted run; a damaged saved seed runs again; an unfinished episode of an
+agent that can resume one goes on from where it stopped, to the same episode."""
 
 import dataclasses
 
+import numpy as np
 import pytest
 
 from softbench import cli
 from softbench import episode_snapshots
+from softbench import episodes
+from softbench import evaluation
 from softbench import records
+from softbench import robots
 from softbench import run
+from softbench import suite
+from softbench.agents import reference
 
 SEEDS = 3
 
@@ -26,11 +33,11 @@ def interrupted_at(seed: int, monkeypatch) -> list[int]:
   """Runs tiny_run() until ``seed`` starts (raising KeyboardInterrupt there); the seeds run."""
   started, episode_and_arm = [], run._episode_and_arm
 
-  def stop_at_seed(settings, index, show_progress):
+  def stop_at_seed(settings, index, *options):
     started.append(index)
     if index == seed:
       raise KeyboardInterrupt
-    return episode_and_arm(settings, index, show_progress)
+    return episode_and_arm(settings, index, *options)
 
   with monkeypatch.context() as patch:
     patch.setattr(run, "_episode_and_arm", stop_at_seed)
@@ -43,9 +50,9 @@ def seeds_run(monkeypatch) -> tuple[dict, list[int]]:
   """A full run of tiny_run(): its record and the seeds it ran (rather than reloaded)."""
   started, episode_and_arm = [], run._episode_and_arm
 
-  def counting(settings, index, show_progress):
+  def counting(settings, index, *options):
     started.append(index)
-    return episode_and_arm(settings, index, show_progress)
+    return episode_and_arm(settings, index, *options)
 
   with monkeypatch.context() as patch:
     patch.setattr(run, "_episode_and_arm", counting)
@@ -156,3 +163,64 @@ def test_a_failed_record_write_keeps_the_seeds_for_the_next_run(monkeypatch, tmp
   assert f"resuming: {SEEDS} of {SEEDS} seeds finished" in capsys.readouterr().err
   assert len(list((tmp_path / "records").glob("*.json"))) == 1
   assert not episode_snapshots.folder(tiny_run()).exists()
+
+
+def _interrupting(monkeypatch, at: list[int]) -> list:
+  """Patches the reference agent to count its steps (``act``) and raise KeyboardInterrupt at the
+  step numbered in ``at`` (from 1; none if empty); the steps taken, as a list."""
+  calls, act = [], reference.ReferenceAgent.act
+
+  def acting(agent, observation):
+    calls.append(observation)
+    if len(calls) in at:
+      raise KeyboardInterrupt
+    return act(agent, observation)
+
+  monkeypatch.setattr(reference.ReferenceAgent, "act", acting)
+  return calls
+
+
+def test_an_interrupted_episode_goes_on_mid_way_to_the_same_episode(monkeypatch, tmp_path):
+  # The reference agent takes seconds a step on babbling; its episodes resume where they stopped,
+  # its memory of simulated actions restored (on tendon-2's babbling, step 5 differs without).
+  arm, steps, unfinished = robots.make("tendon-2"), 8, tmp_path / "unfinished.npz"
+  monkeypatch.setattr(evaluation, "KEEP_INTERVAL_S", 0.0)  # Kept after every step.
+
+  def episode() -> episodes.Episode:
+    env = suite.load(arm, "babbling", seed=0, **suite.length_options("babbling", steps))
+    return evaluation.run_episode(
+      env, reference.ReferenceAgent(arm, 0), "babbling", False, unfinished
+    )
+
+  expected = episode()
+  assert not unfinished.exists()  # Removed once the episode ends.
+  interrupt_at = [5]
+  calls = _interrupting(monkeypatch, interrupt_at)
+  with pytest.raises(KeyboardInterrupt):
+    episode()
+  assert unfinished.exists()
+  calls.clear()
+  interrupt_at.clear()
+  resumed = episode()
+  assert len(calls) == steps - 4  # The agent acts only after the replay of the 4 steps kept.
+  for name in ("targets", "achieved", "poses", "actions", "rewards"):
+    np.testing.assert_array_equal(getattr(resumed, name), getattr(expected, name))
+  assert not unfinished.exists()
+
+
+def test_a_damaged_unfinished_episode_starts_again(monkeypatch):
+  settings = run.settings("babbling", "reference", "tendon-1", seeds=1, profile="tiny")
+  monkeypatch.setattr(evaluation, "KEEP_INTERVAL_S", 0.0)
+  expected = run.fresh_seed(settings, 0)[1]
+  interrupt_at = [3]
+  calls = _interrupting(monkeypatch, interrupt_at)
+  with pytest.raises(KeyboardInterrupt):
+    run.fresh_seed(settings, 0)
+  unfinished = episode_snapshots.partial_path(settings, 0)
+  unfinished.write_bytes(unfinished.read_bytes()[:-50])
+  calls.clear()
+  interrupt_at.clear()
+  with pytest.warns(UserWarning, match="unreadable unfinished episode.*the episode starts again"):
+    again = run.fresh_seed(settings, 0)[1]
+  assert len(calls) == len(expected.actions)
+  np.testing.assert_array_equal(again.actions, expected.actions)

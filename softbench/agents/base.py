@@ -50,3 +50,15 @@ class Agent(abc.ABC):
   @abc.abstractmethod
   def act(self, observation: dict) -> np.ndarray:
     """The action (action_dim,) in [-1, 1] for this control step."""
+
+  def episode_state(self) -> dict[str, np.ndarray] | None:
+    """What ``act`` carries from one step to the next beyond the observation, as arrays, so that
+    an interrupted episode resumes where it stopped, bit for bit (``evaluation.run_episode``:
+    worth it for an agent whose steps take seconds). None, the default: this agent's interrupted
+    episodes start again."""
+    return None
+
+  def restore_episode_state(self, state: dict[str, np.ndarray]) -> None:
+    """Takes back what ``episode_state`` gave, after ``reset`` (and ``bind``) of the same
+    episode."""
+    raise NotImplementedError(f"{type(self).__name__} keeps no episode state")

@@ -111,6 +111,20 @@ class ReferenceAgent(base.Agent):
     self._memory_features = None
     self._restarted = False
 
+  def episode_state(self) -> dict[str, np.ndarray]:
+    """The memory of simulated pairs and whether the episode has restarted (a step of babbling
+    takes seconds: its episodes resume mid-way)."""
+    state = {"memory_actions": self._memory_actions, "restarted": np.asarray(self._restarted)}
+    if self._memory_features is not None:
+      state["memory_features"] = self._memory_features
+    return state
+
+  def restore_episode_state(self, state: dict[str, np.ndarray]) -> None:
+    self._memory_actions = np.array(state["memory_actions"], dtype=float)
+    features = state.get("memory_features")
+    self._memory_features = None if features is None else np.array(features, dtype=float)
+    self._restarted = bool(state["restarted"])
+
   def _simulate(self, actions: np.ndarray, orientation: bool, remember: bool = True) -> np.ndarray:
     """(batch, features) after holding each action (batch, action_dim) for one control period:
     scored tip positions over the arm length, then weighted orientation vectors."""
