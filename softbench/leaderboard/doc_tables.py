@@ -374,7 +374,7 @@ TABLES: dict[str, Callable[[ranking.Leaderboard], Table]] = {
     (TENDON_3, TENDON_3_PAPER, LOCAL_3, LOCAL_3_PAPER, PNEUMATIC, PNEUMATIC_PAPER)
   ),
   "headline-exp1s-spiral": exp1s_headline(
-    (("tendon", "default"), ("tendon", "paper"), ("tendon-local", "default"))
+    (("tendon", "default"), ("tendon", "paper"), ("tendon-local", "default"), ("tendon-local", "paper"))
   ),
   "overview-tendon-3-default": overview_table(TENDON_3),
   "overview-tendon-3-paper": overview_table(TENDON_3_PAPER),
@@ -403,6 +403,8 @@ TABLES: dict[str, Callable[[ranking.Leaderboard], Table]] = {
   "exp1s-tendon-paper": exp1s_table("tendon", "paper"),
   "exp1s-tendon-local-default": exp1s_table("tendon-local", "default"),
   "exp1s-families-default": exp1s_comparison_table("tendon", "tendon-local", "default"),
+  "exp1s-tendon-local-paper": exp1s_table("tendon-local", "paper"),
+  "exp1s-families-paper": exp1s_comparison_table("tendon", "tendon-local", "paper"),
 }
 
 
