@@ -374,7 +374,12 @@ TABLES: dict[str, Callable[[ranking.Leaderboard], Table]] = {
     (TENDON_3, TENDON_3_PAPER, LOCAL_3, LOCAL_3_PAPER, PNEUMATIC, PNEUMATIC_PAPER)
   ),
   "headline-exp1s-spiral": exp1s_headline(
-    (("tendon", "default"), ("tendon", "paper"), ("tendon-local", "default"), ("tendon-local", "paper"))
+    (
+      ("tendon", "default"),
+      ("tendon", "paper"),
+      ("tendon-local", "default"),
+      ("tendon-local", "paper"),
+    )
   ),
   "overview-tendon-3-default": overview_table(TENDON_3),
   "overview-tendon-3-paper": overview_table(TENDON_3_PAPER),
