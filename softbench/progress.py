@@ -30,8 +30,14 @@ class _Progress(rich_progress.Progress):
   """rich's Progress, with a line per bar at most every ``LOG_INTERVAL_S`` where the console is
   not a terminal."""
 
-  def __init__(self, *columns: rich_progress.ProgressColumn, **options) -> None:
+  def __init__(
+    self,
+    *columns: rich_progress.ProgressColumn,
+    logged: tuple[rich_progress.ProgressColumn, ...] = (),
+    **options,
+  ) -> None:
     super().__init__(*columns, **options)
+    self._logged_columns = logged
     self._logged_at: dict[rich_progress.TaskID, float] = {}
     self._relayed_at: dict[rich_progress.TaskID, float] = {}
 
@@ -66,7 +72,10 @@ class _Progress(rich_progress.Progress):
     (task,) = [task for task in self.tasks if task.id == task_id]
     elapsed = datetime.timedelta(seconds=round(task.elapsed or 0.0))
     total = "?" if task.total is None else f"{task.total:g}"
-    self.console.print(f"{task.description}: {task.completed:g}/{total}, {elapsed} elapsed")
+    extra = " ".join(column.render(task).plain for column in self._logged_columns).rstrip(",")
+    extra = f"{extra}, " if extra else ""
+    line = f"{task.description}: {task.completed:g}/{total}, {extra}{elapsed} elapsed"
+    self.console.print(line, soft_wrap=True)  # One line, however long.
 
 
 class _RelayedEpochs:
@@ -106,13 +115,14 @@ def counting(
 ) -> rich_progress.Progress:
   """A progress display whose bars read ``description [bar] done/total [extra] elapsed``;
   nothing at all unless ``show``; gone once finished if ``transient``; on an output that is not
-  a terminal, a line per bar at most every ``LOG_INTERVAL_S``."""
+  a terminal, a line per bar (with the extra columns' text) at most every ``LOG_INTERVAL_S``."""
   return _Progress(
     rich_progress.TextColumn("{task.description}"),
     rich_progress.BarColumn(),
     rich_progress.MofNCompleteColumn(),
     *extra,
     rich_progress.TimeElapsedColumn(),
+    logged=extra,
     disable=not show,
     transient=transient,
   )

@@ -7,6 +7,8 @@ import os
 import queue
 import re
 
+from rich import progress as rich_progress
+
 from softbench import progress
 
 
@@ -31,6 +33,16 @@ def test_a_bar_writes_its_state_to_a_log_at_most_every_interval(capsys, monkeypa
     bars.advance(bar)
   out = capsys.readouterr().out
   assert _state_lines(out) == [] and "2/5" in out  # Only rich's last frame.
+
+
+def test_a_logged_line_carries_the_extra_columns_unwrapped(capsys, monkeypatch):
+  monkeypatch.setattr(progress, "LOG_INTERVAL_S", 0.0)
+  extra = (rich_progress.TextColumn("{task.fields[failed]} failed,"),)
+  label = "a sweep of " + "many " * 20 + "tasks"  # Longer than a log's 80 columns.
+  with progress.counting(extra=extra) as bars:
+    bars.update(bars.add_task(label, total=4, failed=0), completed=1, failed=2)
+  (line,) = _state_lines(capsys.readouterr().out)
+  assert re.fullmatch(rf"{label}: 1/4, 2 failed, \d+:\d\d:\d\d elapsed", line), line
 
 
 def test_a_hidden_bar_writes_nothing(capsys, monkeypatch):

@@ -18,9 +18,9 @@ class Display:
       show,
       extra=(
         rich_progress.TextColumn("{task.fields[running]} running, {task.fields[failed]} failed,"),
-        rich_progress.TextColumn("{task.fields[records]}/{task.fields[settings]} records, ETA"),
+        rich_progress.TextColumn("{task.fields[records]}/{task.fields[settings]} records,"),
         rich_progress.TimeRemainingColumn(),
-        rich_progress.TextColumn("spent"),
+        rich_progress.TextColumn("left,"),
       ),
     )
     self._bar = self._progress.add_task(
