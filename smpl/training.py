@@ -17,6 +17,9 @@ range) and an epoch's training loss rose to `DIVERGED_LOSS_FACTOR` times that (a
 that has not learned yet is not diverged); it starts again from its initial weights with half
 the learning rate, at most `DIVERGENCE_RESTARTS` times, with a warning each time. A training that
 did not diverge is untouched, to the bit.
+
+Devices: a training runs on `default_device()` (CUDA where there is one) and hands its models back
+on the CPU (`on_device`), where a loaded checkpoint is too and where agents act.
 """
 
 from __future__ import annotations
@@ -177,6 +180,24 @@ def seeded(seed: int, device: torch.device) -> Iterator[None]:
 
 
 @contextmanager
+def on_device(device: torch.device, *models: nn.Module) -> Iterator[None]:
+  """Moves `models` to `device` for the block, then back to the CPU, also when the block raises.
+
+  Between trainings every model lives on the CPU: a checkpoint loads there, and agents act there
+  (one step of one sample at a time, which a GPU only slows down), so an agent acts the same
+  whether it was trained a moment ago or loaded. Parameters keep their identity (`nn.Module.to`
+  moves their data), so an optimiser made inside the block still holds them.
+  """
+  for model in models:
+    model.to(device)
+  try:
+    yield
+  finally:
+    for model in models:
+      model.to("cpu")
+
+
+@contextmanager
 def limited_cpu_threads(count: int, device: torch.device) -> Iterator[None]:
   """Sets torch's intra-op thread count for the block when computing on the CPU, then restores it.
 
@@ -210,20 +231,24 @@ def fit(
   `config.max_epochs` or when the validation loss has not improved for `config.patience` epochs;
   the model ends with the weights of its best epoch, in eval mode. The same config and data give
   the same weights. `batch_loss` must use tensors on the model's device: `fit` moves `model` and
-  the windows there, nothing else. Inside `smpl.snapshots.resumable`, a stopped fit resumes
-  where it was (`on_epoch_end` then first gets the epochs already run). A model whose
-  `compiles_on_cpu` is False trains eagerly on the CPU whatever `config.compile` says.
+  the windows there, nothing else, and hands `model` back on the CPU (`on_device`). Inside
+  `smpl.snapshots.resumable`, a stopped fit resumes where it was (`on_epoch_end` then first gets
+  the epochs already run). A model whose `compiles_on_cpu` is False trains eagerly on the CPU
+  whatever `config.compile` says.
   """
   device = device if device is not None else default_device()
   parameters = [parameter for parameter in model.parameters() if parameter.requires_grad]
   if not parameters:
     raise ValueError("the model has no trainable parameters")
-  model.to(device)
   train = train.to(device)
   validation = validation.to(device)
   snapshot = snapshots.next_path()
   fingerprint = _fingerprint(model, train, validation, config) if snapshot else ""
-  with seeded(config.seed, device), limited_cpu_threads(config.cpu_threads, device):
+  with (
+    on_device(device, model),
+    seeded(config.seed, device),
+    limited_cpu_threads(config.cpu_threads, device),
+  ):
     optimizer = torch.optim.Adam(
       parameters, lr=config.learning_rate, weight_decay=config.weight_decay
     )
@@ -431,7 +456,7 @@ def train_inverse_model(
   if not forward_model.is_frozen:
     raise ValueError("the forward model must be trained and frozen before the inverse model")
   device = device if device is not None else default_device()
-  forward_model.to(device).eval()
+  forward_model.eval()
 
   def loss(windows: BabblingWindows, include_aux_loss: bool = True) -> Tensor:
     return inverse_model_loss(
@@ -443,17 +468,18 @@ def train_inverse_model(
       include_aux_loss,
     )
 
-  return _fit_restarting(
-    inverse_model,
-    loss,
-    train,
-    validation,
-    config,
-    device,
-    on_epoch_end,
-    lambda windows: loss(windows, include_aux_loss=False),
-    _zero_action_loss([validation.actions]) if restart_diverged else None,
-  )
+  with on_device(device, forward_model):
+    return _fit_restarting(
+      inverse_model,
+      loss,
+      train,
+      validation,
+      config,
+      device,
+      on_epoch_end,
+      lambda windows: loss(windows, include_aux_loss=False),
+      _zero_action_loss([validation.actions]) if restart_diverged else None,
+    )
 
 
 def train_column_jointly(
@@ -491,7 +517,7 @@ def train_column_jointly(
     raise ValueError("the forward models must be trained and frozen before the inverse model")
   device = device if device is not None else default_device()
   for model in forward_models:
-    model.to(device).eval()
+    model.eval()
 
   loss = joint_action_loss(network, forward_models, column, config.feed_back_error)
   zero_action_loss = (
@@ -499,9 +525,10 @@ def train_column_jointly(
     if restart_diverged
     else None
   )
-  return _fit_restarting(
-    network, loss, train, validation, config, device, on_epoch_end, None, zero_action_loss
-  )
+  with on_device(device, *forward_models):
+    return _fit_restarting(
+      network, loss, train, validation, config, device, on_epoch_end, None, zero_action_loss
+    )
 
 
 def joint_action_loss(

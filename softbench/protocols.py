@@ -190,8 +190,8 @@ def _train_jointly(
           network, forwards, split("train"), split("validation"), config, device, on_epoch_end
         )
       )
-    test = split("test").to(device)
-    with torch.no_grad(), training.limited_cpu_threads(config.cpu_threads, device):
+    test = split("test")  # Scored on the CPU, where the trained models are (training.on_device).
+    with torch.no_grad(), training.limited_cpu_threads(config.cpu_threads, torch.device("cpu")):
       rollouts = smpl_rollout.joint_rollout(network.eval(), test, forwards)
     outcome.scores.append(
       [
