@@ -1,9 +1,10 @@
 """Progress bars of long work: what is done of how much, and the time spent (rich).
 
-rich draws no bars on an output that is not a terminal (a log file of a job in the background)
-until the work ends; there a bar also writes a line of its state at most every
-``LOG_INTERVAL_S``. In a seed worker (``parallel_seeds``), whose bars are not shown, every bar
-sends its state to the parent instead (``relay_to``), which shows a bar per worker."""
+rich draws no bars on an output that is not a terminal (a log file of a job in the background);
+there a bar writes a line of its state instead, at most every ``LOG_INTERVAL_S`` and once more
+when the display stops, in place of rich's last frame (cropped to 80 columns there). In a seed
+worker (``parallel_seeds``), whose bars are not shown, every bar sends its state to the parent
+instead (``relay_to``), which shows a bar per worker."""
 
 import contextlib
 import datetime
@@ -27,8 +28,8 @@ def relay_to(queue) -> None:
 
 
 class _Progress(rich_progress.Progress):
-  """rich's Progress, with a line per bar at most every ``LOG_INTERVAL_S`` where the console is
-  not a terminal."""
+  """rich's Progress, with a line per bar at most every ``LOG_INTERVAL_S``, and one at the end
+  instead of the last frame, where the console is not a terminal."""
 
   def __init__(
     self,
@@ -40,6 +41,17 @@ class _Progress(rich_progress.Progress):
     self._logged_columns = logged
     self._logged_at: dict[rich_progress.TaskID, float] = {}
     self._relayed_at: dict[rich_progress.TaskID, float] = {}
+    self._logs = not self.disable and not self.console.is_terminal
+    if self._logs:
+      self.live.transient = True  # Its lines stand for the last frame.
+
+  def stop(self) -> None:
+    if not (self._logs and self.live.is_started):
+      super().stop()
+      return
+    for task in self.tasks:
+      self._write_line(task)
+    self.live.stop()  # Not Progress.stop, whose blank line would end a last frame.
 
   def update(self, task_id: rich_progress.TaskID, **changes) -> None:
     super().update(task_id, **changes)
@@ -63,13 +75,17 @@ class _Progress(rich_progress.Progress):
     _relay.put((os.getpid(), task.description, task.completed, task.total))
 
   def _log(self, task_id: rich_progress.TaskID) -> None:
-    if self.disable or self.console.is_terminal:
+    if not self._logs:
       return
     now = time.monotonic()
     if now - self._logged_at.setdefault(task_id, now) < LOG_INTERVAL_S:
       return
     self._logged_at[task_id] = now
     (task,) = [task for task in self.tasks if task.id == task_id]
+    self._write_line(task)
+
+  def _write_line(self, task: rich_progress.Task) -> None:
+    """The bar's state as one line, however long: description, done/total, extra, elapsed."""
     elapsed = datetime.timedelta(seconds=round(task.elapsed or 0.0))
     total = "?" if task.total is None else f"{task.total:g}"
     extra = " ".join(column.render(task).plain for column in self._logged_columns).rstrip(",")

@@ -23,16 +23,16 @@ def test_a_bar_writes_its_state_to_a_log_at_most_every_interval(capsys, monkeypa
     bars.update(bar, completed=1)
     bars.advance(bar)
   lines = _state_lines(capsys.readouterr().out)
-  assert len(lines) == 2
-  for line, done in zip(lines, (1, 2)):
+  assert len(lines) == 3  # Each change, then the display's end.
+  for line, done in zip(lines, (1, 2, 2)):
     assert re.fullmatch(rf"seeds: {done}/5, \d+:\d\d:\d\d elapsed", line), line
   monkeypatch.setattr(progress, "LOG_INTERVAL_S", 3600.0)
   with progress.counting() as bars:
     bar = bars.add_task("seeds", total=5)
     bars.update(bar, completed=1)
     bars.advance(bar)
-  out = capsys.readouterr().out
-  assert _state_lines(out) == [] and "2/5" in out  # Only rich's last frame.
+  (line,) = capsys.readouterr().out.splitlines()  # Only the line that ends the display.
+  assert re.fullmatch(r"seeds: 2/5, \d+:\d\d:\d\d elapsed", line), line
 
 
 def test_a_logged_line_carries_the_extra_columns_unwrapped(capsys, monkeypatch):
@@ -41,8 +41,22 @@ def test_a_logged_line_carries_the_extra_columns_unwrapped(capsys, monkeypatch):
   label = "a sweep of " + "many " * 20 + "tasks"  # Longer than a log's 80 columns.
   with progress.counting(extra=extra) as bars:
     bars.update(bars.add_task(label, total=4, failed=0), completed=1, failed=2)
-  (line,) = _state_lines(capsys.readouterr().out)
+  line, last = _state_lines(capsys.readouterr().out)
+  assert line == last  # The change, then the display's end.
   assert re.fullmatch(rf"{label}: 1/4, 2 failed, \d+:\d\d:\d\d elapsed", line), line
+
+
+def test_the_display_ends_with_each_bar_on_one_whole_line(capsys, monkeypatch):
+  monkeypatch.setattr(progress, "LOG_INTERVAL_S", 3600.0)  # Nothing due before the end.
+  extra = (rich_progress.TextColumn("{task.fields[left]} left,"),)
+  labels = ["a sweep of " + "many " * 20 + "tasks", "seeds"]  # The first longer than 80 columns.
+  with progress.counting(extra=extra) as bars:
+    for total, label in enumerate(labels, start=3):
+      bars.update(bars.add_task(label, total=total, left="1:52:10"), completed=2)
+  lines = capsys.readouterr().out.splitlines()
+  assert len(lines) == 2, lines  # No cropped frame of rich's, no blank line.
+  for line, label, total in zip(lines, labels, (3, 4)):
+    assert re.fullmatch(rf"{label}: 2/{total}, 1:52:10 left, \d+:\d\d:\d\d elapsed", line), line
 
 
 def test_a_hidden_bar_writes_nothing(capsys, monkeypatch):
