@@ -29,7 +29,7 @@ def relay_to(queue) -> None:
 
 class _Progress(rich_progress.Progress):
   """rich's Progress, with a line per bar at most every ``LOG_INTERVAL_S``, and one at the end
-  instead of the last frame, where the console is not a terminal."""
+  instead of the last frame (none if transient), where the console is not a terminal."""
 
   def __init__(
     self,
@@ -42,16 +42,16 @@ class _Progress(rich_progress.Progress):
     self._logged_at: dict[rich_progress.TaskID, float] = {}
     self._relayed_at: dict[rich_progress.TaskID, float] = {}
     self._logs = not self.disable and not self.console.is_terminal
-    if self._logs:
-      self.live.transient = True  # Its lines stand for the last frame.
+    self._ends_with_lines = self._logs and not self.live.transient
+    self.live.transient |= self._logs  # In a log, its lines stand for the last frame.
 
   def stop(self) -> None:
     if not (self._logs and self.live.is_started):
       super().stop()
       return
-    for task in self.tasks:
+    for task in self.tasks if self._ends_with_lines else ():
       self._write_line(task)
-    self.live.stop()  # Not Progress.stop, whose blank line would end a last frame.
+    self.live.stop()  # Not Progress.stop, whose blank line ends a frame that a log does not get.
 
   def update(self, task_id: rich_progress.TaskID, **changes) -> None:
     super().update(task_id, **changes)

@@ -59,6 +59,13 @@ def test_the_display_ends_with_each_bar_on_one_whole_line(capsys, monkeypatch):
     assert re.fullmatch(rf"{label}: 2/{total}, 1:52:10 left, \d+:\d\d:\d\d elapsed", line), line
 
 
+def test_a_transient_display_ends_without_a_line(capsys, monkeypatch):
+  monkeypatch.setattr(progress, "LOG_INTERVAL_S", 3600.0)
+  with progress.counting(transient=True) as bars:
+    bars.update(bars.add_task("steps", total=5), completed=5)
+  assert capsys.readouterr().out == ""
+
+
 def test_a_hidden_bar_writes_nothing(capsys, monkeypatch):
   monkeypatch.setattr(progress, "LOG_INTERVAL_S", 0.0)
   with progress.counting(show=False) as bars:
