@@ -55,19 +55,6 @@ def _init_worker(states) -> None:
   progress_bars.relay_to(states)
 
 
-def _show_worker_states(states, progress, bars: dict) -> None:
-  """Shows the states the workers' bars sent (``progress.relay_to``): a bar per worker, showing
-  the work that worker last reported on, restarted (elapsed time too) when that work changes."""
-  while not states.empty():
-    worker, description, completed, total = states.get()
-    if worker not in bars:
-      bars[worker] = progress.add_task(description, total=total), description
-    elif bars[worker][1] != description:
-      bars[worker] = bars[worker][0], description
-      progress.reset(bars[worker][0], total=total, description=description)
-    progress.update(bars[worker][0], completed=completed, total=total)
-
-
 class WorkerDied(RuntimeError):
   """A worker process ended without a result (killed, or out of memory)."""
 
@@ -94,11 +81,11 @@ def in_processes(function, arguments: list[tuple], label: str, workers: int) -> 
       bar = progress.add_task(f"{label} ({workers} processes)", total=len(arguments))
       pending = [executor.submit(function, *entry) for entry in arguments]
       while futures.wait(pending, _POLL_SECONDS, futures.FIRST_EXCEPTION).not_done:
-        _show_worker_states(states, progress, worker_bars)
+        progress_bars.show_relayed(states, progress, worker_bars)
         progress.update(bar, completed=sum(future.done() for future in pending))
         if any(future.done() and future.exception() for future in pending):
           break
-      _show_worker_states(states, progress, worker_bars)
+      progress_bars.show_relayed(states, progress, worker_bars)
       outcomes = [future.result() for future in pending]  # Re-raises a worker's error.
       progress.update(bar, completed=len(arguments))
   except futures.process.BrokenProcessPool:

@@ -21,10 +21,25 @@ _relay = None  # Where this process's bars send their states (a seed worker's qu
 
 def relay_to(queue) -> None:
   """From now on, every bar of this process, shown or not, puts its state on ``queue`` (a
-  multiprocessing ``SimpleQueue``) as ``(process id, description, completed, total)``: at most
-  every ``RELAY_INTERVAL_S`` per bar, and when the bar completes."""
+  multiprocessing ``SimpleQueue``, or a Ray ``Queue`` in a sweep's worker; None: no longer) as
+  ``(process id, description, completed, total)``: at most every ``RELAY_INTERVAL_S`` per bar,
+  and when the bar completes."""
   global _relay  # pylint: disable=global-statement
   _relay = queue
+
+
+def show_relayed(states, progress: rich_progress.Progress, bars: dict, **fields) -> None:
+  """Shows on ``progress`` the states that workers' bars sent to ``states`` (``relay_to``): a bar
+  per worker process (kept in ``bars``, with ``fields`` for the display's columns), showing the
+  work that worker last reported on, restarted (elapsed time too) when that work changes."""
+  while not states.empty():
+    worker, description, completed, total = states.get()
+    if worker not in bars:
+      bars[worker] = progress.add_task(description, total=total, **fields), description
+    elif bars[worker][1] != description:
+      bars[worker] = bars[worker][0], description
+      progress.reset(bars[worker][0], total=total, description=description)
+    progress.update(bars[worker][0], completed=completed, total=total)
 
 
 class _Progress(rich_progress.Progress):
@@ -88,7 +103,8 @@ class _Progress(rich_progress.Progress):
     """The bar's state as one line, however long: description, done/total, extra, elapsed."""
     elapsed = datetime.timedelta(seconds=round(task.elapsed or 0.0))
     total = "?" if task.total is None else f"{task.total:g}"
-    extra = " ".join(column.render(task).plain for column in self._logged_columns).rstrip(",")
+    texts = (column.render(task).plain for column in self._logged_columns)
+    extra = " ".join(text for text in texts if text).rstrip(",")
     extra = f"{extra}, " if extra else ""
     line = f"{task.description}: {task.completed:g}/{total}, {extra}{elapsed} elapsed"
     self.console.print(line, soft_wrap=True)  # One line, however long.

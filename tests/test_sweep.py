@@ -9,6 +9,7 @@ import faulthandler
 import json
 import os
 import pathlib
+import re
 import signal
 import threading
 import time
@@ -93,7 +94,9 @@ def data_home(tmp_path, monkeypatch) -> pathlib.Path:
   return tmp_path / "home"
 
 
-def run_sweep(grid: sweep.Grid, results: pathlib.Path, address: str) -> sweep.SweepResult:
+def run_sweep(
+  grid: sweep.Grid, results: pathlib.Path, address: str, show_progress: bool = False
+) -> sweep.SweepResult:
   return sweep.sweep(
     grid.robots,
     grid.tasks,
@@ -103,7 +106,7 @@ def run_sweep(grid: sweep.Grid, results: pathlib.Path, address: str) -> sweep.Sw
     grid.seeds,
     grid.eval_modes,
     address,
-    show_progress=False,
+    show_progress=show_progress,
     families=grid.families,
   )
 
@@ -185,10 +188,11 @@ def test_a_killed_worker_is_retried_and_a_task_that_raises_fails_only_its_settin
 
 
 def test_an_interrupted_sweep_resumes_to_the_records_softbench_run_writes(
-  address, expected, tmp_path, monkeypatch
+  address, expected, tmp_path, monkeypatch, capsys
 ):
-  # One test for three properties, since each needs whole sweeps on the cluster: the records
-  # equal softbench run's, an interrupted sweep resumes, and settings with a record are skipped.
+  # One test for four properties, since each needs whole sweeps on the cluster: the records
+  # equal softbench run's, an interrupted sweep resumes, settings with a record are skipped, and
+  # the display shows the workers' bars (in a log: each one's last state, at the end).
   results, settings = tmp_path / "results", len(GRID.settings())
   update = display.Display.update
 
@@ -200,11 +204,15 @@ def test_an_interrupted_sweep_resumes_to_the_records_softbench_run_writes(
   with monkeypatch.context() as patch:
     patch.setattr(display.Display, "update", interrupted_after_the_first_record)
     with pytest.raises(KeyboardInterrupt):
-      run_sweep(GRID, results, address)
+      run_sweep(GRID, results, address, show_progress=True)
   assert not ray.is_initialized()
   first = sorted(results.glob("*.json"))
   assert 1 <= len(first) < settings
-  resumed = run_sweep(GRID, results, address)
+  capsys.readouterr()
+  resumed = run_sweep(GRID, results, address, show_progress=True)
+  shown = capsys.readouterr()
+  episodes = re.findall(r"^\w+ seed [01] on (?:circle|reach): 4/4, .* elapsed$", shown.out, re.M)
+  assert episodes, shown.out  # A worker's last episode (the tiny profile's: 4 steps).
   assert sorted(resumed.skipped) == first
   assert len(resumed.written) == settings - len(first)
   assert_records_as_run(results, GRID, expected)

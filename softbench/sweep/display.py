@@ -1,5 +1,7 @@
 """One progress display for a whole sweep: its tasks done of all, running, failed, the records
-written, the time spent and an estimate of the time left (rich)."""
+written, the time spent and an estimate of the time left (rich); under it, a bar per worker
+process of the work it is on (a training's epochs, an episode's steps), relayed from the workers
+(``progress.relay_to``)."""
 
 from rich import progress as rich_progress
 
@@ -7,25 +9,25 @@ from softbench import progress as progress_bars
 
 
 class Display:
-  """A context manager showing one bar over a sweep's Ray tasks (``update`` moves it).
+  """A context manager showing one bar over a sweep's Ray tasks (``update`` moves it) and the
+  workers' bars (``show_workers``).
 
   Running counts the tasks whose inputs are ready, up to the cluster's cores (Ray runs those);
   the time left is rich's estimate from the pace of the tasks so far, which mixes short
-  evaluations with long trainings."""
+  evaluations with long trainings; a worker's bar estimates its own work's."""
 
   def __init__(self, tasks: int, settings: int, show: bool):
     self._progress = progress_bars.counting(
       show,
       extra=(
-        rich_progress.TextColumn("{task.fields[running]} running, {task.fields[failed]} failed,"),
-        rich_progress.TextColumn("{task.fields[records]}/{task.fields[settings]} records,"),
+        rich_progress.TextColumn("{task.fields[counts]}"),
         rich_progress.TimeRemainingColumn(),
         rich_progress.TextColumn("left,"),
       ),
     )
-    self._bar = self._progress.add_task(
-      "sweep: tasks", total=tasks, running=0, failed=0, records=0, settings=settings
-    )
+    self._settings = settings
+    self._bar = self._progress.add_task("sweep: tasks", total=tasks, counts=self._counts(0, 0, 0))
+    self._worker_bars = {}
 
   def __enter__(self) -> "Display":
     self._progress.__enter__()
@@ -34,7 +36,12 @@ class Display:
   def __exit__(self, *exception) -> None:
     self._progress.__exit__(*exception)
 
+  def _counts(self, running: int, failed: int, records: int) -> str:
+    return f"{running} running, {failed} failed, {records}/{self._settings} records,"
+
   def update(self, done: int, running: int, failed: int, records: int) -> None:
-    self._progress.update(
-      self._bar, completed=done, running=running, failed=failed, records=records
-    )
+    self._progress.update(self._bar, completed=done, counts=self._counts(running, failed, records))
+
+  def show_workers(self, states) -> None:
+    """Shows the states that the workers' bars sent to ``states`` (a bar per worker process)."""
+    progress_bars.show_relayed(states, self._progress, self._worker_bars, counts="")

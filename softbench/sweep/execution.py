@@ -18,6 +18,7 @@ import pathlib
 import time
 
 import ray
+from ray.util import queue as ray_queue
 
 from smpl.files import first_line
 from softbench import continual
@@ -42,9 +43,12 @@ def _failure(error: ray.exceptions.RayError) -> str:
   return f"{type(cause).__name__}: {first_line(cause)}"
 
 
-def _submit(plan: grid.Plan) -> dict[ray.ObjectRef, grid.Build | grid.Evaluation]:
+def _submit(
+  plan: grid.Plan, states: ray_queue.Queue | None
+) -> dict[ray.ObjectRef, grid.Build | grid.Evaluation]:
   """Submits every task of ``plan``, each given the refs of the builds it needs (a shipped one's
-  put in the object store); the work of each task's ref, builds first."""
+  put in the object store) and the queue its bars send their states to (``states``, if any);
+  the work of each task's ref, builds first."""
   environment = cluster.runtime_env()
   refs, work = {}, {}
   for build in plan.builds:
@@ -57,7 +61,13 @@ def _submit(plan: grid.Plan) -> dict[ray.ObjectRef, grid.Build | grid.Evaluation
       num_cpus=cores,
       max_retries=cluster.MAX_RETRIES,
       runtime_env=environment,
-    ).remote(build.kind, build.arguments, build.files, *(refs[need] for need in build.needs))
+    ).remote(
+      build.kind,
+      build.arguments,
+      build.files,
+      *(refs[need] for need in build.needs),
+      states=states,
+    )
     work[refs[build]] = build
   for evaluation in plan.evaluations:
     needed = () if evaluation.agent is None else (refs[evaluation.agent],)
@@ -66,7 +76,7 @@ def _submit(plan: grid.Plan) -> dict[ray.ObjectRef, grid.Build | grid.Evaluation
       num_cpus=1,
       max_retries=cluster.MAX_RETRIES,
       runtime_env=environment,
-    ).remote(evaluation.run, evaluation.seed, *needed)
+    ).remote(evaluation.run, evaluation.seed, *needed, states=states)
     work[ref] = evaluation
   return work
 
@@ -104,7 +114,9 @@ def execute(
       episode_snapshots.discard(run)
     written.append(files[0])
 
-  work = _submit(plan)
+  # Where the workers' bars send their states, if shown (an actor of no core).
+  states = ray_queue.Queue(actor_options={"num_cpus": 0}) if show_progress else None
+  work = _submit(plan, states)
   pending, finished, failed = list(work), set(plan.found), 0
   cores = cluster.cores()
   try:
@@ -134,10 +146,15 @@ def execute(
             complete(task.run)
         running = sum(all(need in finished for need in _needs(work[ref])) for ref in pending)
         shown.update(len(finished) - len(plan.found), min(running, cores), failed, len(written))
+        if states is not None:
+          shown.show_workers(states)
   except BaseException:  # Ctrl-C, or a record that cannot be written: nothing more runs.
     for ref in pending:
       ray.cancel(ref, force=True)
     raise
+  finally:
+    if states is not None:
+      states.shutdown()
   return written, {grid.setting_name(run): message for run, message in failures.items()}
 
 

@@ -1,10 +1,10 @@
 """What a sweep's Ray tasks run in their worker processes: builds, evaluations and a node's facts.
 
 Each task first sets its process up as ``softbench run``'s seed workers are (one torch thread,
-``smpl.training.CPU_THREADS``; one-line warnings) and writes the cache files of the builds it is
-given that its data home lacks (``shipping``). A build then finds or makes its cached files and
-returns them; an evaluation returns its seed's record entry and episode (``run.fresh_seed``), or
-an Exp1S seed's scores (``continual.run_seed``).
+``smpl.training.CPU_THREADS``; one-line warnings; its bars relayed to the sweep's display) and
+writes the cache files of the builds it is given that its data home lacks (``shipping``). A build
+then finds or makes its cached files and returns them; an evaluation returns its seed's record
+entry and episode (``run.fresh_seed``), or an Exp1S seed's scores (``continual.run_seed``).
 """
 
 import ray
@@ -16,6 +16,7 @@ from softbench import continual
 from softbench import data
 from softbench import episode_snapshots
 from softbench import parallel_seeds
+from softbench import progress
 from softbench import robots
 from softbench import run as run_module
 from softbench.agents import learned
@@ -23,11 +24,13 @@ from softbench.agents import learners
 from softbench.sweep import shipping
 
 
-def _set_up() -> None:
-  """As ``parallel_seeds._init_worker``, except Ctrl-C, which the driver handles by cancelling,
-  and progress bars: the sweep's display counts tasks."""
+def _set_up(states) -> None:
+  """As ``parallel_seeds._init_worker``, except Ctrl-C, which the driver handles by cancelling:
+  one torch thread, one-line warnings, and the task's bars relayed to the driver's ``states``
+  (a Ray queue; None where the sweep shows no progress)."""
   torch.set_num_threads(training.CPU_THREADS)
   parallel_seeds.one_line_warnings()
+  progress.relay_to(states)
 
 
 def _collect(robot: str, samples: int) -> None:
@@ -58,20 +61,26 @@ BUILDERS = {
 }
 
 
-def build(kind: str, arguments: tuple, files: tuple[str, ...], *needed: shipping.Files):
-  """Builds (or finds) a ``grid.Build`` of ``kind`` from the builds it needs; its cache files."""
-  _set_up()
+def build(
+  kind: str, arguments: tuple, files: tuple[str, ...], *needed: shipping.Files, states=None
+):
+  """Builds (or finds) a ``grid.Build`` of ``kind`` from the builds it needs; its cache files.
+  ``states``: where its bars send their states (``_set_up``)."""
+  _set_up(states)
   shipping.write_missing(*needed)
   BUILDERS[kind](*arguments)
   return shipping.read(files)
 
 
 def evaluate(
-  run: run_module.RunSettings | continual.RunSettings, seed: int, *needed: shipping.Files
+  run: run_module.RunSettings | continual.RunSettings,
+  seed: int,
+  *needed: shipping.Files,
+  states=None,
 ):
   """Seed ``seed``'s record entry and episode of ``run``, by the agent of ``needed`` if any; of
-  an Exp1S run, the seed's scores, by the network of ``needed``."""
-  _set_up()
+  an Exp1S run, the seed's scores, by the network of ``needed``. ``states``: as ``build``'s."""
+  _set_up(states)
   shipping.write_missing(*needed)
   if isinstance(run, continual.RunSettings):
     return continual.run_seed(seed, run.profile, run.family)
