@@ -55,6 +55,12 @@ def _init_worker(states) -> None:
   progress_bars.relay_to(states)
 
 
+def _received(states) -> Iterator[tuple]:
+  """The states on the ``states`` queue now, in the order they were put."""
+  while not states.empty():
+    yield states.get()
+
+
 class WorkerDied(RuntimeError):
   """A worker process ended without a result (killed, or out of memory)."""
 
@@ -81,11 +87,11 @@ def in_processes(function, arguments: list[tuple], label: str, workers: int) -> 
       bar = progress.add_task(f"{label} ({workers} processes)", total=len(arguments))
       pending = [executor.submit(function, *entry) for entry in arguments]
       while futures.wait(pending, _POLL_SECONDS, futures.FIRST_EXCEPTION).not_done:
-        progress_bars.show_relayed(states, progress, worker_bars)
+        progress_bars.show_relayed(_received(states), progress, worker_bars)
         progress.update(bar, completed=sum(future.done() for future in pending))
         if any(future.done() and future.exception() for future in pending):
           break
-      progress_bars.show_relayed(states, progress, worker_bars)
+      progress_bars.show_relayed(_received(states), progress, worker_bars)
       outcomes = [future.result() for future in pending]  # Re-raises a worker's error.
       progress.update(bar, completed=len(arguments))
   except futures.process.BrokenProcessPool:

@@ -6,6 +6,7 @@ when the display stops, in place of rich's last frame (cropped to 80 columns the
 worker (``parallel_seeds``), whose bars are not shown, every bar sends its state to the parent
 instead (``relay_to``), which shows a bar per worker."""
 
+from collections.abc import Iterable
 import contextlib
 import datetime
 import os
@@ -21,19 +22,20 @@ _relay = None  # Where this process's bars send their states (a seed worker's qu
 
 def relay_to(queue) -> None:
   """From now on, every bar of this process, shown or not, puts its state on ``queue`` (a
-  multiprocessing ``SimpleQueue``, or a Ray ``Queue`` in a sweep's worker; None: no longer) as
+  multiprocessing ``SimpleQueue``, or a sweep's ``sweep.relay.Relay``; None: no longer) as
   ``(process id, description, completed, total)``: at most every ``RELAY_INTERVAL_S`` per bar,
   and when the bar completes."""
   global _relay  # pylint: disable=global-statement
   _relay = queue
 
 
-def show_relayed(states, progress: rich_progress.Progress, bars: dict, **fields) -> None:
-  """Shows on ``progress`` the states that workers' bars sent to ``states`` (``relay_to``): a bar
+def show_relayed(
+  states: Iterable[tuple], progress: rich_progress.Progress, bars: dict, **fields
+) -> None:
+  """Shows on ``progress`` the ``states`` that workers' bars sent (``relay_to``), in order: a bar
   per worker process (kept in ``bars``, with ``fields`` for the display's columns), showing the
   work that worker last reported on, restarted (elapsed time too) when that work changes."""
-  while not states.empty():
-    worker, description, completed, total = states.get()
+  for worker, description, completed, total in states:
     if worker not in bars:
       bars[worker] = progress.add_task(description, total=total, **fields), description
     elif bars[worker][1] != description:

@@ -3,6 +3,8 @@ written, the time spent and an estimate of the time left (rich); under it, a bar
 process of the work it is on (a training's epochs, an episode's steps), relayed from the workers
 (``progress.relay_to``)."""
 
+from collections.abc import Iterable
+
 from rich import progress as rich_progress
 
 from softbench import progress as progress_bars
@@ -42,6 +44,6 @@ class Display:
   def update(self, done: int, running: int, failed: int, records: int) -> None:
     self._progress.update(self._bar, completed=done, counts=self._counts(running, failed, records))
 
-  def show_workers(self, states) -> None:
-    """Shows the states that the workers' bars sent to ``states`` (a bar per worker process)."""
+  def show_workers(self, states: Iterable[tuple]) -> None:
+    """Shows the ``states`` that the workers' bars sent, in order (a bar per worker process)."""
     progress_bars.show_relayed(states, self._progress, self._worker_bars, counts="")

@@ -18,7 +18,6 @@ import pathlib
 import time
 
 import ray
-from ray.util import queue as ray_queue
 
 from smpl.files import first_line
 from softbench import continual
@@ -29,6 +28,7 @@ from softbench.records import provenance
 from softbench.sweep import cluster
 from softbench.sweep import display
 from softbench.sweep import grid
+from softbench.sweep import relay
 from softbench.sweep import shipping
 from softbench.sweep import tasks
 
@@ -44,10 +44,10 @@ def _failure(error: ray.exceptions.RayError) -> str:
 
 
 def _submit(
-  plan: grid.Plan, states: ray_queue.Queue | None
+  plan: grid.Plan, states: relay.Relay | None
 ) -> dict[ray.ObjectRef, grid.Build | grid.Evaluation]:
   """Submits every task of ``plan``, each given the refs of the builds it needs (a shipped one's
-  put in the object store) and the queue its bars send their states to (``states``, if any);
+  put in the object store) and the relay its bars send their states to (``states``, if any);
   the work of each task's ref, builds first."""
   environment = cluster.runtime_env()
   refs, work = {}, {}
@@ -114,8 +114,7 @@ def execute(
       episode_snapshots.discard(run)
     written.append(files[0])
 
-  # Where the workers' bars send their states, if shown (an actor of no core).
-  states = ray_queue.Queue(actor_options={"num_cpus": 0}) if show_progress else None
+  states = relay.Relay() if show_progress else None  # The workers' bars, if shown.
   work = _submit(plan, states)
   pending, finished, failed = list(work), set(plan.found), 0
   cores = cluster.cores()
@@ -146,15 +145,15 @@ def execute(
             complete(task.run)
         running = sum(all(need in finished for need in _needs(work[ref])) for ref in pending)
         shown.update(len(finished) - len(plan.found), min(running, cores), failed, len(written))
-        if states is not None:
-          shown.show_workers(states)
+        if states is not None:  # A finished task's last states came before its result.
+          shown.show_workers(states.take())
   except BaseException:  # Ctrl-C, or a record that cannot be written: nothing more runs.
     for ref in pending:
       ray.cancel(ref, force=True)
     raise
   finally:
     if states is not None:
-      states.shutdown()
+      states.close()
   return written, {grid.setting_name(run): message for run, message in failures.items()}
 
 

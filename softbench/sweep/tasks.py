@@ -7,6 +7,9 @@ then finds or makes its cached files and returns them; an evaluation returns its
 entry and episode (``run.fresh_seed``), or an Exp1S seed's scores (``continual.run_seed``).
 """
 
+from collections.abc import Iterator
+import contextlib
+
 import ray
 import torch
 
@@ -21,16 +24,24 @@ from softbench import robots
 from softbench import run as run_module
 from softbench.agents import learned
 from softbench.agents import learners
+from softbench.sweep import relay
 from softbench.sweep import shipping
 
 
-def _set_up(states) -> None:
-  """As ``parallel_seeds._init_worker``, except Ctrl-C, which the driver handles by cancelling:
-  one torch thread, one-line warnings, and the task's bars relayed to the driver's ``states``
-  (a Ray queue; None where the sweep shows no progress)."""
+@contextlib.contextmanager
+def _relayed(states: relay.Relay | None) -> Iterator[None]:
+  """The task's process set up as ``parallel_seeds._init_worker`` sets a seed worker up, except
+  Ctrl-C, which the driver handles by cancelling: one torch thread, one-line warnings, and the
+  task's bars relayed to the driver's ``states`` (None where the sweep shows no progress), all
+  sent by the end of the block."""
   torch.set_num_threads(training.CPU_THREADS)
   parallel_seeds.one_line_warnings()
   progress.relay_to(states)
+  try:
+    yield
+  finally:
+    if states is not None:
+      states.flush()
 
 
 def _collect(robot: str, samples: int) -> None:
@@ -65,10 +76,10 @@ def build(
   kind: str, arguments: tuple, files: tuple[str, ...], *needed: shipping.Files, states=None
 ):
   """Builds (or finds) a ``grid.Build`` of ``kind`` from the builds it needs; its cache files.
-  ``states``: where its bars send their states (``_set_up``)."""
-  _set_up(states)
-  shipping.write_missing(*needed)
-  BUILDERS[kind](*arguments)
+  ``states``: where its bars send their states (``_relayed``)."""
+  with _relayed(states):
+    shipping.write_missing(*needed)
+    BUILDERS[kind](*arguments)
   return shipping.read(files)
 
 
@@ -80,11 +91,11 @@ def evaluate(
 ):
   """Seed ``seed``'s record entry and episode of ``run``, by the agent of ``needed`` if any; of
   an Exp1S run, the seed's scores, by the network of ``needed``. ``states``: as ``build``'s."""
-  _set_up(states)
-  shipping.write_missing(*needed)
-  if isinstance(run, continual.RunSettings):
-    return continual.run_seed(seed, run.profile, run.family)
-  return run_module.fresh_seed(run, seed)
+  with _relayed(states):
+    shipping.write_missing(*needed)
+    if isinstance(run, continual.RunSettings):
+      return continual.run_seed(seed, run.profile, run.family)
+    return run_module.fresh_seed(run, seed)
 
 
 def node_facts() -> tuple[str, str]:
