@@ -105,7 +105,8 @@ def sweep(
       from softbench.sweep import cluster  # pylint: disable=import-outside-toplevel
       from softbench.sweep import execution  # pylint: disable=import-outside-toplevel
 
-      with parallel_seeds.sigterm_as_interrupt(), cluster.connected(address):
+      # After Ray starts: its own handler of SIGTERM, which ray.init installs, aborts the process.
+      with cluster.connected(address), parallel_seeds.sigterm_as_interrupt():
         written, failures = execution.execute(work, folder, show_progress)
   if failures:
     raise SweepFailed(
