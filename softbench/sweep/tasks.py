@@ -73,7 +73,11 @@ BUILDERS = {
 
 
 def build(
-  kind: str, arguments: tuple, files: tuple[str, ...], *needed: shipping.Files, states=None
+  kind: str,
+  arguments: tuple,
+  files: tuple[str, ...],
+  *needed: shipping.Files,
+  states: relay.Relay | None = None,
 ):
   """Builds (or finds) a ``grid.Build`` of ``kind`` from the builds it needs; its cache files.
   ``states``: where its bars send their states (``_relayed``)."""
@@ -87,7 +91,7 @@ def evaluate(
   run: run_module.RunSettings | continual.RunSettings,
   seed: int,
   *needed: shipping.Files,
-  states=None,
+  states: relay.Relay | None = None,
 ):
   """Seed ``seed``'s record entry and episode of ``run``, by the agent of ``needed`` if any; of
   an Exp1S run, the seed's scores, by the network of ``needed``. ``states``: as ``build``'s."""
