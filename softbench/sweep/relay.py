@@ -32,7 +32,10 @@ class Relay:
     self._last = None  # This process's last put, not yet waited for.
 
   def put(self, state: tuple) -> None:
-    self._last = self._mailbox.put.remote(state)  # Not waited for (see above).
+    """Sends a bar's ``(process id, description, completed, total)``, the process named by its
+    node too (process ids of two nodes may be equal)."""
+    worker = (ray.get_runtime_context().get_node_id(), state[0])
+    self._last = self._mailbox.put.remote((worker, *state[1:]))  # Not waited for (see above).
 
   def flush(self) -> None:
     """Waits until the actor holds every state this process put (an actor runs one caller's
