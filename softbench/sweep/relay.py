@@ -6,6 +6,8 @@ A task waits once, at its end (``flush``), so that the driver has its bars' last
 has the task's result.
 """
 
+import contextlib
+
 import ray
 
 
@@ -49,4 +51,6 @@ class Relay:
     return ray.get(self._mailbox.take.remote())
 
   def close(self) -> None:
-    ray.kill(self._mailbox)
+    """Ends the actor; quietly where Ray itself is gone (the error that ended the sweep says so)."""
+    with contextlib.suppress(ray.exceptions.RayError):
+      ray.kill(self._mailbox)
