@@ -198,7 +198,7 @@ def test_an_interrupted_sweep_resumes_to_the_records_softbench_run_writes(
 
   def interrupted_after_the_first_record(shown, done, running, failed, written):
     update(shown, done, running, failed, written)
-    if 1 <= written < settings:  # kill, as Ctrl-C (which ray.init's own SIGTERM handler aborted).
+    if 1 <= written < settings:  # kill ends it as Ctrl-C does (ray.init's own handler aborted).
       os.kill(os.getpid(), signal.SIGTERM)
 
   with monkeypatch.context() as patch:
