@@ -1,7 +1,14 @@
 """The ``softbench`` command line. It parses arguments and calls the library; a bad input gets
-one line on stderr and exit code 2, a malformed command line included."""
+one line on stderr and exit code 2, a malformed command line included.
+
+Only the command that runs has its arguments built, and a command's arguments and handler import
+the modules they need themselves: ``softbench --help`` and the listings start without loading
+torch, Ray or the plotting stack (6 s here, when every command's modules were imported)."""
 
 import argparse
+from collections.abc import Callable
+from collections.abc import Collection
+import dataclasses
 import os
 import pathlib
 import sys
@@ -9,34 +16,9 @@ import sys
 from dm_control.rl import control
 
 import softbench
-from softbench import adaptive
-from softbench import agents
-from softbench import continual
-from softbench import data
-from softbench import leaderboard
-from softbench import listings
-from softbench import parallel_seeds
 from softbench import profiles
-from softbench import retrain as retrain_module
-from softbench import robots
-from softbench import run as run_module
-from softbench import saving
 from softbench import storage
-from softbench import suite
-from softbench import sweep  # Ray loads only when a sweep runs.
 from softbench import terminal
-from softbench import tuning
-from softbench import zoo
-from softbench.data import dataset
-from softbench.data import seeding
-from softbench.leaderboard import doc_tables
-from softbench.leaderboard import grid
-from softbench.leaderboard import zoo_catalogue
-from softbench.leaderboard import zoo_verification
-from softbench.rendering import options as video_options
-from softbench.rendering import video
-from softbench.robots import export as model_export
-from softbench.zoo import listing as zoo_listing
 
 EXIT_USAGE = 2
 _JSON_HELP = "print JSON (for scripts) instead of a table"
@@ -71,12 +53,17 @@ def _robot_overrides(args: argparse.Namespace) -> dict:
 
 
 def _robots(args: argparse.Namespace) -> None:
+  from softbench import listings
+
   if args.json:
     return terminal.print_json(listings.robots_document(args.name, **_robot_overrides(args)))
   terminal.show(listings.robots_table(args.name, **_robot_overrides(args)))
 
 
 def _models_export(args: argparse.Namespace) -> None:
+  from softbench import robots
+  from softbench.robots import export as model_export
+
   out = storage.check_writable(args.out, "models to", folder=True)
   chosen = [robots.make(name) for name in args.robots or robots.BENCHMARK_ROBOTS]  # Checked first.
   for robot in chosen:
@@ -85,24 +72,32 @@ def _models_export(args: argparse.Namespace) -> None:
 
 
 def _tasks(args: argparse.Namespace) -> None:
+  from softbench import listings
+
   if args.json:
     return terminal.print_json(listings.tasks_document())
   terminal.show(listings.tasks_table())
 
 
 def _collect(args: argparse.Namespace) -> None:
+  from softbench import data
+
   collected = data.collect(args.robot, samples=args.samples, seed=args.seed, workers=args.workers)
   print(collected.describe())
   print(collected.path)
 
 
 def _agents(args: argparse.Namespace) -> None:
+  from softbench import listings
+
   if args.json:
     return terminal.print_json(listings.agents_document())
   terminal.show(listings.agents_table(args.verbose))
 
 
 def _tune(args: argparse.Namespace) -> None:
+  from softbench import tuning
+
   settings = tuning.settings(
     args.agent, args.robot, args.trials, args.storage, args.profile, args.study, args.epochs
   )
@@ -110,6 +105,9 @@ def _tune(args: argparse.Namespace) -> None:
 
 
 def _run_protocol(args: argparse.Namespace) -> None:
+  from softbench import continual
+  from softbench import saving
+
   settings = continual.settings(
     args.protocol,
     args.agent,
@@ -126,13 +124,20 @@ def _run_protocol(args: argparse.Namespace) -> None:
   continual.finish(record, files)
 
 
-def _video_request(args: argparse.Namespace, path: str) -> run_module.VideoRequest:
-  """A video of the options the video flags give, to ``path``; both checked."""
+def _video_request(args: argparse.Namespace, path: str):
+  """A ``run.VideoRequest`` of the options the video flags give, to ``path``; both checked."""
+  from softbench import run as run_module
+  from softbench.rendering import options as video_options
+
   options = video_options.from_text(**{name: getattr(args, name) for name in _VIDEO_OPTIONS})
   return run_module.VideoRequest(video_options.check_video_path(path), options)
 
 
 def _run(args: argparse.Namespace) -> None:
+  from softbench import run as run_module
+  from softbench import saving
+  from softbench.data import dataset
+
   video_flags = _flags_given(args, _VIDEO_OPTIONS)
   if args.video is None and video_flags:
     raise ValueError(
@@ -171,6 +176,10 @@ def _run(args: argparse.Namespace) -> None:
 
 
 def _render(args: argparse.Namespace) -> None:
+  from softbench import run as run_module
+  from softbench.data import seeding
+  from softbench.rendering import options as video_options
+
   request = _video_request(args, args.out)
   seed = video_options.parse_number("seed", args.seed, int)
   seeding.check_seed(seed)
@@ -182,6 +191,8 @@ def _render(args: argparse.Namespace) -> None:
 
 def _add_video_arguments(parser: argparse.ArgumentParser) -> None:
   """The flags of ``_VIDEO_OPTIONS``; left out, they are None (``from_text`` takes the default)."""
+  from softbench.rendering import options as video_options
+
   parser.add_argument(
     "--width", help=f"frame width in pixels, even (default {video_options.DEFAULT_WIDTH})"
   )
@@ -218,10 +229,12 @@ def _add_eval_argument(parser: argparse.ArgumentParser) -> None:
 def _add_results_argument(
   parser: argparse.ArgumentParser, what: str = "folder of the result records"
 ) -> None:
+  from softbench import records
+
   parser.add_argument(
     "--results",
-    default=str(leaderboard.DEFAULT_RESULTS),
-    help=f"{what} (default {leaderboard.DEFAULT_RESULTS})",
+    default=str(records.DEFAULT_FOLDER),
+    help=f"{what} (default {records.DEFAULT_FOLDER})",
   )
 
 
@@ -242,6 +255,9 @@ def _check_record_arguments(args: argparse.Namespace) -> None:
 
 
 def _sweep(args: argparse.Namespace) -> None:
+  from softbench import continual
+  from softbench import sweep
+
   if args.protocol is None and args.families is not None:
     raise ValueError(f"--families goes with --protocol {continual.PROTOCOL}")
   if args.protocol is not None:
@@ -262,6 +278,10 @@ def _sweep(args: argparse.Namespace) -> None:
 
 
 def _leaderboard(args: argparse.Namespace) -> None:
+  from softbench import leaderboard
+  from softbench.leaderboard import doc_tables
+  from softbench.leaderboard import grid
+
   if args.grid is not None:
     print(" ".join(grid.lists()[args.grid]))
     return
@@ -277,6 +297,9 @@ def _leaderboard(args: argparse.Namespace) -> None:
 
 
 def _retrain(args: argparse.Namespace) -> None:
+  from softbench import retrain as retrain_module
+  from softbench import saving
+
   settings = retrain_module.settings(
     args.agent, args.robot, tuple(args.fault), args.profile, args.task, args.seeds, args.baseline
   )
@@ -286,10 +309,17 @@ def _retrain(args: argparse.Namespace) -> None:
 
 
 def _zoo_list(args: argparse.Namespace) -> None:
+  from softbench import zoo
+  from softbench.zoo import listing as zoo_listing
+
   terminal.show(zoo_listing.contents(zoo.chosen_folder(args.zoo)))
 
 
 def _zoo_add(args: argparse.Namespace) -> None:
+  from softbench import zoo
+  from softbench.leaderboard import zoo_catalogue
+  from softbench.zoo import listing as zoo_listing
+
   chosen = zoo_catalogue.requested_setting(
     args.agent, args.robot, args.protocol, args.family, args.profile, args.seeds
   )
@@ -301,6 +331,9 @@ def _zoo_add(args: argparse.Namespace) -> None:
 
 
 def _zoo_verify(args: argparse.Namespace) -> None:
+  from softbench import zoo
+  from softbench.leaderboard import zoo_verification
+
   zoo_verification.verify_zoo(
     pathlib.Path(args.results),
     zoo.chosen_folder(args.zoo),
@@ -325,323 +358,284 @@ class _OneLineErrorParser(argparse.ArgumentParser):
     self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
-def build_parser() -> argparse.ArgumentParser:
-  parser = _OneLineErrorParser(prog="softbench", description=__doc__.split(".")[0] + ".")
-  parser.add_argument("--version", action="version", version=f"softbench {softbench.__version__}")
-  commands = parser.add_subparsers(dest="command", required=True)
-  robots_parser = commands.add_parser("robots", help="list the benchmark robots or describe one")
-  robots_parser.add_argument("name", nargs="?", help="e.g. tendon-3 or pneumatic-433")
-  robots_parser.add_argument("--module-length", type=float, help="module length in m")
-  robots_parser.add_argument("--json", action="store_true", help=_JSON_HELP)
-  robots_parser.set_defaults(run=_robots)
-  tasks_parser = commands.add_parser("tasks", help="list the tasks of the suite")
-  tasks_parser.add_argument("--json", action="store_true", help=_JSON_HELP)
-  tasks_parser.set_defaults(run=_tasks)
-  collect_parser = commands.add_parser(
-    "collect",
-    help="record (or resume) a motor-babbling dataset",
-    description="Motor babbling with every module active, cached under $SOFTBENCH_HOME "
-    "(default $XDG_CACHE_HOME/softbench, or ~/.cache/softbench); an interrupted "
-    "collection resumes.",
-  )
-  collect_parser.add_argument("--robot", required=True, help="e.g. tendon-3 or pneumatic-433")
-  collect_parser.add_argument(
+def _robots_arguments(parser: argparse.ArgumentParser) -> None:
+  parser.add_argument("name", nargs="?", help="e.g. tendon-3 or pneumatic-433")
+  parser.add_argument("--module-length", type=float, help="module length in m")
+  parser.add_argument("--json", action="store_true", help=_JSON_HELP)
+
+
+def _tasks_arguments(parser: argparse.ArgumentParser) -> None:
+  parser.add_argument("--json", action="store_true", help=_JSON_HELP)
+
+
+def _collect_arguments(parser: argparse.ArgumentParser) -> None:
+  from softbench import data
+
+  parser.add_argument("--robot", required=True, help="e.g. tendon-3 or pneumatic-433")
+  parser.add_argument(
     "--samples",
     type=int,
     default=data.DEFAULT_SAMPLES,
     help=f"control periods to record (default {data.DEFAULT_SAMPLES})",
   )
-  collect_parser.add_argument("--seed", type=int, default=0, help="seed of the random actions")
-  collect_parser.add_argument(
+  parser.add_argument("--seed", type=int, default=0, help="seed of the random actions")
+  parser.add_argument(
     "--workers", type=int, default=None, help="simulation threads (default: every core)"
   )
-  collect_parser.set_defaults(run=_collect)
-  agents_parser = commands.add_parser("agents", help="list the agents")
-  agents_parser.add_argument(
+
+
+def _agents_arguments(parser: argparse.ArgumentParser) -> None:
+  parser.add_argument(
     "--verbose", action="store_true", help="also show each learned agent's hyperparameters"
   )
-  agents_parser.add_argument(
-    "--json", action="store_true", help=_JSON_HELP + ", hyperparameters included"
-  )
-  agents_parser.set_defaults(run=_agents)
-  tune_parser = commands.add_parser(
-    "tune",
-    help="tune a learned agent's hyperparameters with Optuna",
-    description="Runs (or resumes) an Optuna study of the agent's hyperparameters on the "
-    "babbling validation split; the same budget for every agent.",
-  )
-  tune_parser.add_argument("--agent", required=True, help="a learned agent, e.g. smpl or lstm")
-  tune_parser.add_argument("--robot", required=True, help="e.g. tendon-3 or pneumatic-433")
-  tune_parser.add_argument(
+  parser.add_argument("--json", action="store_true", help=_JSON_HELP + ", hyperparameters included")
+
+
+def _tune_arguments(parser: argparse.ArgumentParser) -> None:
+  from softbench import tuning
+
+  parser.add_argument("--agent", required=True, help="a learned agent, e.g. smpl or lstm")
+  parser.add_argument("--robot", required=True, help="e.g. tendon-3 or pneumatic-433")
+  parser.add_argument(
     "--trials",
     type=int,
     default=tuning.DEFAULT_TRIALS,
-    help=f"finished trials the study should hold (default "
-    f"{tuning.DEFAULT_TRIALS}); "
+    help=f"finished trials the study should hold (default {tuning.DEFAULT_TRIALS}); "
     "re-running adds the missing ones",
   )
-  tune_parser.add_argument(
+  parser.add_argument(
     "--storage", help="Optuna storage URL (default: sqlite:///$SOFTBENCH_HOME/tuning.db)"
   )
-  tune_parser.add_argument(
+  parser.add_argument(
     "--profile",
     default=profiles.DEFAULT_PROFILE,
     help=f"data and epoch budget: one of {', '.join(profiles.PROFILES)} "
     f"(default {profiles.DEFAULT_PROFILE})",
   )
-  tune_parser.add_argument(
+  parser.add_argument(
     "--epochs",
     type=int,
     help="epoch budget of each trial's inverse model (default: the "
     "profile's; fewer buys more trials)",
   )
-  tune_parser.add_argument("--study", help="study name (default AGENT-ROBOT-PROFILE)")
-  tune_parser.add_argument(
+  parser.add_argument("--study", help="study name (default AGENT-ROBOT-PROFILE)")
+  parser.add_argument(
     "--summary", help="where to write the study summary (default $SOFTBENCH_HOME/tuning/STUDY.json)"
   )
-  tune_parser.add_argument(
+  parser.add_argument(
     "--confirm",
     action="store_true",
     help="then train the previous and the best values at the profile's "
     "full epoch budget and report both",
   )
-  tune_parser.add_argument(
+  parser.add_argument(
     "--adopt",
     action="store_true",
     help="commit the best values as the agent's hyperparameters on the "
     "robot (softbench/agents/hyperparameters.json)",
   )
-  tune_parser.set_defaults(run=_tune)
-  run_parser = commands.add_parser(
-    "run",
-    help="train (or reuse) an agent and score it on a task over seeds",
-    description="Collects or reuses the babbling dataset, trains or reuses the agent (cached "
-    "by config), evaluates it (closed loop in physics unless --eval says otherwise) "
-    "and prints the errors over seeds.",
-  )
-  run_parser.add_argument("--task", help=f"one of {', '.join(suite.TASKS)}")
-  run_parser.add_argument(
+
+
+def _run_arguments(parser: argparse.ArgumentParser) -> None:
+  from softbench import adaptive
+  from softbench import agents
+  from softbench import continual
+  from softbench import robots
+  from softbench import suite
+
+  parser.add_argument("--task", help=f"one of {', '.join(suite.TASKS)}")
+  parser.add_argument(
     "--protocol",
     help=f"{continual.PROTOCOL}: SMPL learns tendon-1 .. "
     f"tendon-5 (or another --family's arms) in sequence; "
     f"prints the paper's Exp1S table and the forgetting "
     f"matrix",
   )
-  run_parser.add_argument(
+  parser.add_argument(
     "--family",
     help=f"with --protocol {continual.PROTOCOL}: the tendon "
     f"family whose arms 1 .. 5 SMPL learns, one of "
     f"{', '.join(robots.TENDON_FAMILIES)} (default "
     f"{continual.DEFAULT_FAMILY})",
   )
-  run_parser.add_argument("--agent", required=True, help=f"one of {', '.join(agents.AGENTS)}")
-  run_parser.add_argument(
+  parser.add_argument("--agent", required=True, help=f"one of {', '.join(agents.AGENTS)}")
+  parser.add_argument(
     "--robot", help="default: the task's robot in the paper (tendon-3; pneumatic-433 for reach)"
   )
-  run_parser.add_argument("--seeds", type=int, help="number of seeds (default: the profile's)")
-  run_parser.add_argument(
+  parser.add_argument("--seeds", type=int, help="number of seeds (default: the profile's)")
+  parser.add_argument(
     "--workers",
     type=int,
     help="processes that run seeds in parallel (default: one per core, at "
     "most one per seed); more than the cores keeps them all busy "
     "while the last seeds run, e.g. 3 for 5 seeds on 2 cores",
   )
-  _add_profile_argument(run_parser)
-  _add_eval_argument(run_parser)
-  run_parser.add_argument("--trajectory", help="target poses for --task custom (.npy or .csv)")
-  run_parser.add_argument(
+  _add_profile_argument(parser)
+  _add_eval_argument(parser)
+  parser.add_argument("--trajectory", help="target poses for --task custom (.npy or .csv)")
+  parser.add_argument(
     "--given",
     help="the part of every module's pose the --trajectory file gives: MODULES[:position], "
     "e.g. 3:position (module 3's position only) or 1,3 (modules 1 and 3, whole poses); "
     "a learned agent completes the rest (default: every module's whole pose)",
   )
-  run_parser.add_argument(
+  parser.add_argument(
     "--module", type=int, help="the module that reaches (--task reach; default 2)"
   )
-  run_parser.add_argument(
+  parser.add_argument(
     "--adaptive",
     action="store_true",
     help="--task reach with adaptive module activation: the reaching "
     "module alone, then its neighbours while they lower the error",
   )
-  run_parser.add_argument(
+  parser.add_argument(
     "--targets",
     type=int,
     help=f"virtual targets of --adaptive (default {adaptive.DEFAULT_TARGETS})",
   )
-  run_parser.add_argument(
+  parser.add_argument(
     "--helpers",
     help="how a learned agent completes a partial target (reach, --adaptive): "
     "complete (default; nearest babbling pose refined through its forward models, "
     "corrected from the measured error), nearest (the nearest babbling pose), "
     "hold (every other module at its starting pose) or share (the reaching module's error)",
   )
-  _add_record_arguments(run_parser)
-  run_parser.add_argument("--video", help="also render seed 0's episode to this .mp4 file")
-  _add_video_arguments(run_parser)
-  run_parser.add_argument(
+  _add_record_arguments(parser)
+  parser.add_argument("--video", help="also render seed 0's episode to this .mp4 file")
+  _add_video_arguments(parser)
+  parser.add_argument(
     "--fault",
     action="append",
     default=[],
     help=_FAULT_HELP + "; the agent is trained on the healthy robot",
   )
-  run_parser.set_defaults(run=_run)
-  sweep_parser = commands.add_parser(
-    "sweep",
-    help="run a grid of robots, tasks and agents (and Exp1S) as Ray tasks, here or on a cluster",
-    description="Runs every setting (robot, task, agent, eval mode; with --protocol exp1s, "
-    "Exp1S on each of --families) that --results has no record of for the profile, as Ray "
-    "tasks: each babbling dataset, forward model, agent and Exp1S network is built once and "
-    "shared, and each record is the one softbench run writes. Without --address, on a local "
-    "Ray with one worker per core; docs/sweep.md for a cluster.",
-  )
-  sweep_parser.add_argument(
+
+
+def _sweep_arguments(parser: argparse.ArgumentParser) -> None:
+  from softbench import agents
+  from softbench import continual
+  from softbench import robots
+  from softbench import suite
+
+  parser.add_argument(
     "--robots", nargs="+", default=[], metavar="ROBOT", help="e.g. tendon-1 tendon-3"
   )
-  sweep_parser.add_argument(
+  parser.add_argument(
     "--tasks", nargs="+", default=[], metavar="TASK", help=f"of {', '.join(suite.TASKS)}"
   )
-  sweep_parser.add_argument(
+  parser.add_argument(
     "--agents", nargs="+", default=[], metavar="AGENT", help=f"of {', '.join(agents.AGENTS)}"
   )
-  sweep_parser.add_argument(
+  parser.add_argument(
     "--protocol",
     help=f"{continual.PROTOCOL}: also SMPL's Exp1S on each of --families (then --robots, "
     "--tasks and --agents may be left out)",
   )
-  sweep_parser.add_argument(
+  parser.add_argument(
     "--families",
     nargs="+",
     metavar="FAMILY",
     help=f"with --protocol {continual.PROTOCOL}: of {', '.join(robots.TENDON_FAMILIES)} "
     f"(default {continual.DEFAULT_FAMILY})",
   )
-  _add_profile_argument(sweep_parser)
-  sweep_parser.add_argument("--seeds", type=int, help="number of seeds (default: the profile's)")
-  sweep_parser.add_argument(
+  _add_profile_argument(parser)
+  parser.add_argument("--seeds", type=int, help="number of seeds (default: the profile's)")
+  parser.add_argument(
     "--eval",
     nargs="+",
     default=["physics"],
     metavar="MODE",
     help="the error fed back: physics (default), model, open-loop; several: a setting each",
   )
-  sweep_parser.add_argument(
+  parser.add_argument(
     "--address",
     help="HOST:PORT of a Ray cluster's head (ray start --head); default: a local Ray",
   )
-  sweep_parser.add_argument(
+  parser.add_argument(
     "--data-home",
     help="the data home of this machine and every worker, e.g. on shared storage "
     "(default: $SOFTBENCH_HOME)",
   )
-  _add_results_argument(sweep_parser)
-  sweep_parser.add_argument(
+  _add_results_argument(parser)
+  parser.add_argument(
     "--dry-run",
     action="store_true",
     help="print the settings that have no record yet and what they need built; run nothing",
   )
-  sweep_parser.set_defaults(run=_sweep)
 
-  board_parser = commands.add_parser(
-    "leaderboard",
-    help="rank the result records per robot and task",
-    description="Checks every result record (schema and integrity hash) and prints, per robot "
-    "and task, the newest record of each agent, profile and eval mode, ranked by "
-    "position error: mean ± std over seeds [95% bootstrap CI].",
-  )
-  _add_results_argument(board_parser)
-  board_parser.add_argument(
+
+def _leaderboard_arguments(parser: argparse.ArgumentParser) -> None:
+  from softbench import leaderboard
+  from softbench.leaderboard import grid
+
+  _add_results_argument(parser)
+  parser.add_argument(
     "--write",
     action="store_true",
     help="also regenerate README.md and index.html in --out, and the "
     "results tables of the checkout's README.md and docs/*.md",
   )
-  board_parser.add_argument(
+  parser.add_argument(
     "--out",
     default=str(leaderboard.DEFAULT_OUT),
     help=f"folder of the pages (default {leaderboard.DEFAULT_OUT})",
   )
-  board_parser.add_argument(
+  parser.add_argument(
     "--grid",
     choices=tuple(grid.lists()),
     help="print the names on one axis of the grid make leaderboard fills, and nothing else",
   )
-  board_parser.set_defaults(run=_leaderboard)
-  render_parser = commands.add_parser(
-    "render",
-    help="render an agent's episode of a task to an MP4 video",
-    description="Trains (or reuses) the agent for one seed, runs its episode and renders it "
-    "off-screen (the MUJOCO_GL you set, else egl, else osmesa) with the target "
-    "trail and the achieved tip path.",
-  )
-  render_parser.add_argument("--task", required=True, help=f"one of {', '.join(suite.TASKS)}")
-  render_parser.add_argument("--agent", required=True, help=f"one of {', '.join(agents.AGENTS)}")
-  render_parser.add_argument("--robot", help="default: the task's robot in the paper")
-  render_parser.add_argument("--out", required=True, help="the video file (.mp4)")
-  render_parser.add_argument("--seed", default="0", help="agent and environment seed (default 0)")
-  _add_profile_argument(render_parser)
-  _add_eval_argument(render_parser)
-  render_parser.add_argument("--trajectory", help="target poses for --task custom (.npy or .csv)")
-  render_parser.add_argument(
+
+
+def _render_arguments(parser: argparse.ArgumentParser) -> None:
+  from softbench import agents
+  from softbench import suite
+
+  parser.add_argument("--task", required=True, help=f"one of {', '.join(suite.TASKS)}")
+  parser.add_argument("--agent", required=True, help=f"one of {', '.join(agents.AGENTS)}")
+  parser.add_argument("--robot", help="default: the task's robot in the paper")
+  parser.add_argument("--out", required=True, help="the video file (.mp4)")
+  parser.add_argument("--seed", default="0", help="agent and environment seed (default 0)")
+  _add_profile_argument(parser)
+  _add_eval_argument(parser)
+  parser.add_argument("--trajectory", help="target poses for --task custom (.npy or .csv)")
+  parser.add_argument(
     "--given", help="the part of every module's pose the --trajectory file gives (as for run)"
   )
-  _add_video_arguments(render_parser)
-  render_parser.set_defaults(run=_render)
-  retrain_parser = commands.add_parser(
-    "retrain",
-    help="retrain the faulty module's SMPL column after an actuator fault",
-    description="Collects babbling on the faulty robot, retrains only the faulty module's "
-    "column of the smpl agent (and the forward models from that module on), and "
-    "compares the errors before the fault, under it, after retraining one column "
-    "and of a centralised baseline retrained from scratch, with wall times.",
-  )
-  retrain_parser.add_argument(
+  _add_video_arguments(parser)
+
+
+def _retrain_arguments(parser: argparse.ArgumentParser) -> None:
+  from softbench import retrain as retrain_module
+
+  parser.add_argument(
     "--agent",
     default=retrain_module.RETRAINED_AGENT,
     help="the agent to adapt (smpl, the default, is the only one)",
   )
-  retrain_parser.add_argument("--robot", help="default: the task's robot in the paper")
-  retrain_parser.add_argument(
+  parser.add_argument("--robot", help="default: the task's robot in the paper")
+  parser.add_argument(
     "--fault", action="append", default=[], help=_FAULT_HELP + "; every fault in one module"
   )
-  retrain_parser.add_argument(
+  parser.add_argument(
     "--task", default=retrain_module.DEFAULT_TASK, help=f"default {retrain_module.DEFAULT_TASK}"
   )
-  retrain_parser.add_argument(
+  parser.add_argument(
     "--baseline",
     default=retrain_module.DEFAULT_BASELINE,
     help=f"centralised baseline retrained from scratch (default {retrain_module.DEFAULT_BASELINE})",
   )
-  retrain_parser.add_argument("--seeds", type=int, help="number of seeds (default: the profile's)")
-  _add_profile_argument(retrain_parser)
-  _add_record_arguments(retrain_parser)
-  retrain_parser.set_defaults(run=_retrain)
-  _add_zoo_parser(commands)
-  models = commands.add_parser("models", help="exported MJCF models")
-  models_commands = models.add_subparsers(dest="models_command", required=True)
-  export_parser = models_commands.add_parser("export", help="write models/<name>/ for every robot")
-  export_parser.add_argument("--out", default="models", help="output folder (default: models)")
-  export_parser.add_argument(
-    "--robots",
-    nargs="+",
-    metavar="ROBOT",
-    help="export only these robots (default: every benchmark robot)",
-  )
-  export_parser.add_argument(
-    "--measure-speed", action="store_true", help="also measure simulation speed into speed.json"
-  )
-  export_parser.set_defaults(run=_models_export)
-  return parser
+  parser.add_argument("--seeds", type=int, help="number of seeds (default: the profile's)")
+  _add_profile_argument(parser)
+  _add_record_arguments(parser)
 
 
-def _add_zoo_parser(commands) -> None:
-  zoo_parser = commands.add_parser(
-    "zoo",
-    help="trained weights kept in the repository: list, add, verify",
-    description="The zoo holds the weights behind leaderboard records (and the saved state of "
-    "unfinished trainings); softbench run takes them instead of training.",
-  )
-  zoo_commands = zoo_parser.add_subparsers(dest="zoo_command", required=True)
+def _zoo_arguments(parser: argparse.ArgumentParser) -> None:
+  from softbench import continual
+  from softbench import robots
+  from softbench import zoo
+
+  zoo_commands = parser.add_subparsers(dest="zoo_command", required=True)
   zoo_help = f"the zoo folder (default ${zoo.VARIABLE}, else zoo/ of the checkout)"
   list_parser = zoo_commands.add_parser("list", help="the zoo's files, sizes and records")
   list_parser.add_argument("--zoo", help=zoo_help)
@@ -686,35 +680,180 @@ def _add_zoo_parser(commands) -> None:
   verify_parser.set_defaults(run=_zoo_verify)
 
 
+def _models_arguments(parser: argparse.ArgumentParser) -> None:
+  models_commands = parser.add_subparsers(dest="models_command", required=True)
+  export_parser = models_commands.add_parser("export", help="write models/<name>/ for every robot")
+  export_parser.add_argument("--out", default="models", help="output folder (default: models)")
+  export_parser.add_argument(
+    "--robots",
+    nargs="+",
+    metavar="ROBOT",
+    help="export only these robots (default: every benchmark robot)",
+  )
+  export_parser.add_argument(
+    "--measure-speed", action="store_true", help="also measure simulation speed into speed.json"
+  )
+  export_parser.set_defaults(run=_models_export)
+
+
+@dataclasses.dataclass(frozen=True)
+class _Command:
+  """A command: its line in ``softbench --help``, the function that adds its arguments (and
+  imports what their help names), the handler that runs it (None where its own subcommands
+  name theirs) and its description in ``softbench COMMAND --help``."""
+
+  help: str
+  add_arguments: Callable[[argparse.ArgumentParser], None]
+  run: Callable[[argparse.Namespace], None] | None
+  description: str | None = None
+
+
+_COMMANDS = {
+  "robots": _Command("list the benchmark robots or describe one", _robots_arguments, _robots),
+  "tasks": _Command("list the tasks of the suite", _tasks_arguments, _tasks),
+  "collect": _Command(
+    "record (or resume) a motor-babbling dataset",
+    _collect_arguments,
+    _collect,
+    "Motor babbling with every module active, cached under $SOFTBENCH_HOME "
+    "(default $XDG_CACHE_HOME/softbench, or ~/.cache/softbench); an interrupted "
+    "collection resumes.",
+  ),
+  "agents": _Command("list the agents", _agents_arguments, _agents),
+  "tune": _Command(
+    "tune a learned agent's hyperparameters with Optuna",
+    _tune_arguments,
+    _tune,
+    "Runs (or resumes) an Optuna study of the agent's hyperparameters on the "
+    "babbling validation split; the same budget for every agent.",
+  ),
+  "run": _Command(
+    "train (or reuse) an agent and score it on a task over seeds",
+    _run_arguments,
+    _run,
+    "Collects or reuses the babbling dataset, trains or reuses the agent (cached "
+    "by config), evaluates it (closed loop in physics unless --eval says otherwise) "
+    "and prints the errors over seeds.",
+  ),
+  "sweep": _Command(
+    "run a grid of robots, tasks and agents (and Exp1S) as Ray tasks, here or on a cluster",
+    _sweep_arguments,
+    _sweep,
+    "Runs every setting (robot, task, agent, eval mode; with --protocol exp1s, "
+    "Exp1S on each of --families) that --results has no record of for the profile, as Ray "
+    "tasks: each babbling dataset, forward model, agent and Exp1S network is built once and "
+    "shared, and each record is the one softbench run writes. Without --address, on a local "
+    "Ray with one worker per core; docs/sweep.md for a cluster.",
+  ),
+  "leaderboard": _Command(
+    "rank the result records per robot and task",
+    _leaderboard_arguments,
+    _leaderboard,
+    "Checks every result record (schema and integrity hash) and prints, per robot "
+    "and task, the newest record of each agent, profile and eval mode, ranked by "
+    "position error: mean ± std over seeds [95% bootstrap CI].",
+  ),
+  "render": _Command(
+    "render an agent's episode of a task to an MP4 video",
+    _render_arguments,
+    _render,
+    "Trains (or reuses) the agent for one seed, runs its episode and renders it "
+    "off-screen (the MUJOCO_GL you set, else egl, else osmesa) with the target "
+    "trail and the achieved tip path.",
+  ),
+  "retrain": _Command(
+    "retrain the faulty module's SMPL column after an actuator fault",
+    _retrain_arguments,
+    _retrain,
+    "Collects babbling on the faulty robot, retrains only the faulty module's "
+    "column of the smpl agent (and the forward models from that module on), and "
+    "compares the errors before the fault, under it, after retraining one column "
+    "and of a centralised baseline retrained from scratch, with wall times.",
+  ),
+  "zoo": _Command(
+    "trained weights kept in the repository: list, add, verify",
+    _zoo_arguments,
+    None,
+    "The zoo holds the weights behind leaderboard records (and the saved state of "
+    "unfinished trainings); softbench run takes them instead of training.",
+  ),
+  "models": _Command("exported MJCF models", _models_arguments, None),
+}
+
+
+def build_parser(commands: Collection[str] = tuple(_COMMANDS)) -> argparse.ArgumentParser:
+  """The command line's parser, with the arguments of ``commands`` (default: every command's;
+  the others keep their line in ``softbench --help``, and their modules stay unimported)."""
+  parser = _OneLineErrorParser(prog="softbench", description=__doc__.split(".")[0] + ".")
+  parser.add_argument("--version", action="version", version=f"softbench {softbench.__version__}")
+  subparsers = parser.add_subparsers(dest="command", required=True)
+  for name, entry in _COMMANDS.items():
+    command_parser = subparsers.add_parser(name, help=entry.help, description=entry.description)
+    if name in commands:
+      entry.add_arguments(command_parser)
+      if entry.run is not None:
+        command_parser.set_defaults(run=entry.run)
+  return parser
+
+
+def _command_named(argv: list[str]) -> str | None:
+  """The command ``argv`` names: its first word that is not an option (softbench's own options,
+  ``--help`` and ``--version``, take no value)."""
+  return next((word for word in argv if not word.startswith("-")), None)
+
+
 _CACHING_COMMANDS = ("collect", "run", "render", "retrain", "tune")  # They write to the data home.
+# Errors of a command's modules, as "module:class", that end it with one line: a bad input
+# (EXIT_USAGE, as ValueError does), and a run that failed (EXIT_FAILURE).
+_USAGE_ERRORS = ("softbench.rendering.video:RenderingUnavailable",)
+_RUN_FAILURES = (
+  "softbench.parallel_seeds:WorkerDied",
+  "softbench.rendering.video:RenderingFailed",
+  "softbench.continual:ForgettingDetected",
+  "softbench.leaderboard.zoo_verification:ZooMismatch",
+  "softbench.sweep:SweepFailed",
+)
+
+
+def _imported_classes(names: tuple[str, ...]) -> tuple[type[BaseException], ...]:
+  """The classes ``names`` ("module:class") of the modules imported so far. An error of a module
+  never imported cannot have been raised, so catching only these loads nothing more."""
+  found = []
+  for entry in names:
+    module_name, _, class_name = entry.partition(":")
+    module = sys.modules.get(module_name)  # None where not imported: it has no such class.
+    if hasattr(module, class_name):
+      found.append(getattr(module, class_name))
+  return tuple(found)
 
 
 def main(argv: list[str] | None = None) -> int:
+  argv = sys.argv[1:] if argv is None else argv
   try:
-    args = build_parser().parse_args(argv)
+    named = _command_named(argv)
+    args = build_parser([named] if named else []).parse_args(argv)
   except SystemExit as done:  # --help (0), or a malformed command line (one line, 2).
     return done.code
-  parallel_seeds.one_line_warnings()
+  terminal.one_line_warnings()
   try:
-    with parallel_seeds.sigterm_as_interrupt():
+    with terminal.sigterm_as_interrupt():
       if args.command in _CACHING_COMMANDS:  # Before any work: a home that takes no file fails
         storage.check_home()  # at once, not after the first seed.
       args.run(args)
-  except (ValueError, FileNotFoundError, FloatingPointError, video.RenderingUnavailable) as error:
-    print(f"softbench: error: {dataset.first_line(error)}", file=sys.stderr)
-    return EXIT_USAGE
   except (
-    parallel_seeds.WorkerDied,
-    video.RenderingFailed,
-    continual.ForgettingDetected,
-    zoo_verification.ZooMismatch,
-    sweep.SweepFailed,
+    ValueError,
+    FileNotFoundError,
+    FloatingPointError,
+    *_imported_classes(_USAGE_ERRORS),
   ) as error:
-    print(f"softbench: error: {dataset.first_line(error)}", file=sys.stderr)
+    print(f"softbench: error: {storage.first_line(error)}", file=sys.stderr)
+    return EXIT_USAGE
+  except _imported_classes(_RUN_FAILURES) as error:
+    print(f"softbench: error: {storage.first_line(error)}", file=sys.stderr)
     return EXIT_FAILURE
   except control.PhysicsError as error:  # MuJoCo's state blew up during an episode.
     print(
-      f"softbench: error: the simulation became unstable ({dataset.first_line(error)})",
+      f"softbench: error: the simulation became unstable ({storage.first_line(error)})",
       file=sys.stderr,
     )
     return EXIT_FAILURE
@@ -733,7 +872,7 @@ def main(argv: list[str] | None = None) -> int:
 def _describe_os_error(error: OSError) -> str:
   """``error`` in one line: the file and the system's reason when it names them."""
   if error.filename is None or not error.strerror:
-    return dataset.first_line(error)
+    return storage.first_line(error)
   target = f" -> {error.filename2}" if error.filename2 is not None else ""
   return f"{error.filename}{target}: {error.strerror}"
 

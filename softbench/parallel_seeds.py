@@ -5,43 +5,18 @@ the next run)."""
 
 from collections.abc import Iterator
 from concurrent import futures
-import contextlib
 import multiprocessing
 import os
 import signal
-import threading
-import warnings
 
 import torch
 
 from smpl import training
 from softbench import progress as progress_bars
+from softbench import terminal
 from softbench.data import dataset
 
 _POLL_SECONDS = 0.2  # (s) How often the parent looks at its worker processes.
-
-
-def one_line_warnings() -> None:
-  """Prints warnings as ``softbench: warning: MESSAGE``, without file, line and source."""
-  warnings.formatwarning = lambda message, *_, **__: f"softbench: warning: {message}\n"
-
-
-def _interrupt(signal_number: int, frame) -> None:
-  raise KeyboardInterrupt
-
-
-@contextlib.contextmanager
-def sigterm_as_interrupt() -> Iterator[None]:
-  """Within the block (in the main thread), ``kill`` stops softbench as Ctrl-C does: the seed
-  workers are terminated rather than left running without their parent."""
-  if threading.current_thread() is not threading.main_thread():
-    yield
-    return
-  previous = signal.signal(signal.SIGTERM, _interrupt)
-  try:
-    yield
-  finally:
-    signal.signal(signal.SIGTERM, previous)
 
 
 def _init_worker(states) -> None:
@@ -51,7 +26,7 @@ def _init_worker(states) -> None:
   print as in the parent; progress bars send their states to the parent's ``states`` queue."""
   torch.set_num_threads(training.CPU_THREADS)
   signal.signal(signal.SIGINT, signal.SIG_IGN)
-  one_line_warnings()
+  terminal.one_line_warnings()
   progress_bars.relay_to(states)
 
 

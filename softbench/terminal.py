@@ -1,11 +1,16 @@
-"""Output of the command line: tables for people (rich), which read as plain lines when piped, and
-JSON documents for scripts."""
+"""The command line's terminal: tables for people (rich), which read as plain lines when piped,
+JSON documents for scripts, warnings in one line, and ``kill`` taken as Ctrl-C."""
 
 from collections.abc import Collection
 from collections.abc import Iterable
+from collections.abc import Iterator
 from collections.abc import Sequence
+import contextlib
 import json
+import signal
 import sys
+import threading
+import warnings
 
 from rich.console import Console
 from rich.console import RenderableType
@@ -44,3 +49,26 @@ def show(renderable: RenderableType) -> None:
 def print_json(document) -> None:
   """Prints ``document`` as indented JSON (the ``--json`` of a listing); NaN is refused."""
   print(json.dumps(document, indent=2, allow_nan=False))
+
+
+def one_line_warnings() -> None:
+  """Prints warnings as ``softbench: warning: MESSAGE``, without file, line and source."""
+  warnings.formatwarning = lambda message, *_, **__: f"softbench: warning: {message}\n"
+
+
+def _interrupt(signal_number: int, frame) -> None:
+  raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def sigterm_as_interrupt() -> Iterator[None]:
+  """Within the block (in the main thread), ``kill`` stops softbench as Ctrl-C does: the seed
+  workers are terminated rather than left running without their parent."""
+  if threading.current_thread() is not threading.main_thread():
+    yield
+    return
+  previous = signal.signal(signal.SIGTERM, _interrupt)
+  try:
+    yield
+  finally:
+    signal.signal(signal.SIGTERM, previous)

@@ -20,6 +20,7 @@ from softbench import protocols
 from softbench import robots
 from softbench import run
 from softbench import suite
+from softbench import terminal
 from softbench.agents import forward_models
 from softbench.agents import learned
 
@@ -455,7 +456,7 @@ def test_help_still_prints_the_usage(capsys):
 
 def test_warnings_print_on_one_line(monkeypatch):
   monkeypatch.setattr(warnings, "formatwarning", warnings.formatwarning)  # Restored afterwards.
-  parallel_seeds.one_line_warnings()
+  terminal.one_line_warnings()
   assert (
     warnings.formatwarning(
       "snapshot unreadable", RuntimeWarning, "training.py", 215, "saved = load()"

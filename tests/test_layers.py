@@ -1,7 +1,8 @@
 """The package's layers import one way: no cycle among softbench's units (its subpackages and
 top-level modules), counting every import statement, deferred ones too; and the agent registry,
-the records, the leaderboard and the listings of the command line import without torch, and what
-seed workers import without matplotlib."""
+the records, the leaderboard and the listings of the command line import without torch, the
+command line's help and listings run without it, and what seed workers import without
+matplotlib."""
 
 import ast
 import pathlib
@@ -129,6 +130,33 @@ def test_the_registries_and_the_records_import_without_torch(modules):
   code = f"import sys, {modules}; print('torch' in sys.modules)"
   result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
   assert result.stdout.strip() == "False"
+
+
+# Commands that read what is registered or recorded, and the help of every command but the one
+# asked about. One child for them all: each is a fresh start only for torch's sake.
+TORCHLESS_COMMANDS = (
+  ["--help"],
+  ["--version"],
+  ["robots", "tendon-3"],
+  ["tasks", "--json"],
+  ["agents"],
+  ["leaderboard", "--grid", "agents"],
+  ["models"],
+)
+
+
+def test_the_help_and_the_listings_of_the_command_line_load_no_torch():
+  code = (
+    "import sys\n"
+    "from softbench import cli\n"
+    f"codes = [cli.main(argv) for argv in {list(TORCHLESS_COMMANDS)!r}]\n"
+    "print(codes, 'torch' in sys.modules, file=sys.stderr)"
+  )
+  result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+  codes_and_torch = result.stderr.strip().splitlines()[-1]
+  # --help, --version and a command missing its subcommand end as argparse ends them: 0, 0, 2.
+  assert codes_and_torch == "[0, 0, 0, 0, 0, 0, 2] False"
+  assert "usage: softbench" in result.stdout and "tendon-3" in result.stdout
 
 
 def _module_file(module: str) -> pathlib.Path | None:

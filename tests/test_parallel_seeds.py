@@ -99,9 +99,10 @@ signal.signal(signal.SIGINT, signal.default_int_handler)
 sys.path.insert(0, {tests!r})
 from softbench import parallel_seeds
 from softbench import progress
+from softbench import terminal
 import test_parallel_seeds
 try:
-  with parallel_seeds.sigterm_as_interrupt():  # As softbench.cli.main runs every command.
+  with terminal.sigterm_as_interrupt():  # As softbench.cli.main runs every command.
     parallel_seeds.in_processes(test_parallel_seeds.sleep_long, [(0,), (1,)], "sleepers", workers=2)
 except KeyboardInterrupt:
   import multiprocessing

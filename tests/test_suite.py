@@ -15,9 +15,9 @@ import pytest
 from softbench import agents
 from softbench import cli
 from softbench import data
-from softbench import parallel_seeds
 from softbench import robots
 from softbench import suite
+from softbench import terminal
 from softbench.data import dataset
 from softbench.robots import recorder
 from softbench.suite import references
@@ -216,7 +216,7 @@ def test_a_damaged_reference_warns_on_one_softbench_line(monkeypatch, tmp_path):
   with pytest.warns(dataset.CorruptFileWarning) as caught:
     references.reference(arm, "circle", length=4)
   monkeypatch.setattr(warnings, "formatwarning", warnings.formatwarning)
-  parallel_seeds.one_line_warnings()  # As the command line prints warnings.
+  terminal.one_line_warnings()  # As the command line prints warnings.
   (warning,) = caught
   printed = warnings.formatwarning(
     warning.message, warning.category, warning.filename, warning.lineno

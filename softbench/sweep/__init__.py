@@ -19,9 +19,9 @@ import os
 import pathlib
 import sys
 
-from softbench import parallel_seeds
 from softbench import profiles
 from softbench import storage
+from softbench import terminal
 from softbench.sweep.grid import Grid
 from softbench.sweep.grid import plan
 
@@ -106,7 +106,7 @@ def sweep(
       from softbench.sweep import execution  # pylint: disable=import-outside-toplevel
 
       # After Ray starts: its own handler of SIGTERM, which ray.init installs, aborts the process.
-      with cluster.connected(address), parallel_seeds.sigterm_as_interrupt():
+      with cluster.connected(address), terminal.sigterm_as_interrupt():
         written, failures = execution.execute(work, folder, show_progress)
   if failures:
     raise SweepFailed(

@@ -18,10 +18,10 @@ from softbench import agents
 from softbench import continual
 from softbench import data
 from softbench import episode_snapshots
-from softbench import parallel_seeds
 from softbench import progress
 from softbench import robots
 from softbench import run as run_module
+from softbench import terminal
 from softbench.agents import learned
 from softbench.agents import learners
 from softbench.sweep import relay
@@ -35,7 +35,7 @@ def _relayed(states: relay.Relay | None) -> Iterator[None]:
   task's bars relayed to the driver's ``states`` (None where the sweep shows no progress), all
   sent by the end of the block."""
   torch.set_num_threads(training.CPU_THREADS)
-  parallel_seeds.one_line_warnings()
+  terminal.one_line_warnings()
   progress.relay_to(states)
   try:
     yield
