@@ -1,10 +1,13 @@
 """Fixtures shared by the test files."""
 
 import contextlib
+import io
 import os
+import pathlib
 import shutil
 import subprocess
 import sys
+import tempfile
 
 import pytest
 import worker_hooks
@@ -28,22 +31,29 @@ def no_repository_zoo(monkeypatch):
 
 
 @pytest.fixture(scope="session")
-def babbled_datasets(tmp_path_factory):
+def run_folder(tmp_path_factory) -> pathlib.Path:
+  """A folder that every test process of this pytest run shares (pytest-xdist's workers: their
+  common temporary root), for what is worth making once per run rather than once per process."""
+  if "PYTEST_XDIST_WORKER" not in os.environ:  # Not distributed: this process's own root.
+    return tmp_path_factory.getbasetemp()
+  return tmp_path_factory.getbasetemp().parent
+
+
+@pytest.fixture(scope="session")
+def babbled_datasets(run_folder):
   """``of(robot)``: the datasets folder of a data home holding ``robot``'s tiny babbling dataset
-  (data seed ``learned.DATA_SEED``), collected once per test process: collecting it took most of
-  a tiny training's time."""
-  collected = {}
+  (data seed ``learned.DATA_SEED``), collected once per test run: collecting it took most of a
+  tiny training's time. Test processes share that data home as users' processes do (the first
+  collects, the others wait for it and read it; their waiting line is not shown)."""
 
   def of(robot: str):
-    if robot not in collected:
-      template = tmp_path_factory.mktemp(f"babbled-{robot}")
-      with pytest.MonkeyPatch.context() as patched:
-        patched.setenv("SOFTBENCH_HOME", str(template))
-        data.collect(
-          robot, samples=profiles.get("tiny").samples, seed=learned.DATA_SEED, progress=False
-        )
-      collected[robot] = template / data_files.DATASETS_FOLDER
-    return collected[robot]
+    template = run_folder / f"babbled-{robot}"
+    with pytest.MonkeyPatch.context() as patched, contextlib.redirect_stderr(io.StringIO()):
+      patched.setenv("SOFTBENCH_HOME", str(template))
+      data.collect(
+        robot, samples=profiles.get("tiny").samples, seed=learned.DATA_SEED, progress=False
+      )
+    return template / data_files.DATASETS_FOLDER
 
   return of
 
@@ -62,6 +72,36 @@ def babbled_home(monkeypatch, babbled_datasets):
     )
     monkeypatch.setenv("SOFTBENCH_HOME", str(home))
     return home
+
+  return into
+
+
+@pytest.fixture(scope="session")
+def run_wide_homes(run_folder, babbled_datasets):
+  """``of(robot)``: ``robot``'s run-wide data home, holding its tiny dataset: one home that every
+  test process of the run shares, as users' processes may, so that what a test makes there (a
+  tiny agent, a reference) is made once per run. Only for tests that read back what they make:
+  none damages a file or keeps a run there."""
+
+  def of(robot: str) -> pathlib.Path:
+    home = run_folder / f"run-wide-{robot}"
+    if not (home / data_files.DATASETS_FOLDER).exists():  # Copied whole, then moved in at once.
+      home.mkdir(parents=True, exist_ok=True)
+      with tempfile.TemporaryDirectory(dir=home) as incoming:
+        shutil.copytree(babbled_datasets(robot), pathlib.Path(incoming) / "datasets")
+        with contextlib.suppress(OSError):  # Another process moved its copy in first.
+          os.rename(pathlib.Path(incoming) / "datasets", home / data_files.DATASETS_FOLDER)
+    return home
+
+  return of
+
+
+@pytest.fixture
+def run_wide_home(monkeypatch, run_wide_homes):
+  """``into(robot)``: makes ``run_wide_homes(robot)`` the data home."""
+
+  def into(robot: str):
+    monkeypatch.setenv("SOFTBENCH_HOME", str(run_wide_homes(robot)))
 
   return into
 

@@ -19,9 +19,10 @@ MODULE_ENTRIES = {1: range(0, 4), 2: range(4, 7), 3: range(7, 10)}
 
 
 @pytest.fixture(autouse=True)
-def shared_home(tmp_path_factory, monkeypatch):
-  """One data home for the file: the tiny dataset and checkpoints are made once."""
-  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path_factory.getbasetemp() / "adaptive_home"))
+def shared_home(run_wide_home):
+  """The run's data home of ROBOT: its agents are trained once (``TestEveryAgent`` of
+  test_agents_and_run uses them too)."""
+  run_wide_home(ROBOT)
 
 
 def drive(errors: dict, num_modules: int = 3, target: int = 2, threshold: float = 1.0):

@@ -33,9 +33,10 @@ LEARNED_AGENTS = [name for name in agents.AGENTS if agents.describe(name).learne
 
 
 @pytest.fixture(autouse=True)
-def shared_home(tmp_path_factory, monkeypatch):
-  """One data home for the file: datasets and checkpoints are made once, then reused."""
-  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path_factory.getbasetemp() / "agents_home"))
+def shared_home(tmp_path_factory, babbled_home):
+  """One data home for the file, holding tendon-2's tiny dataset: checkpoints are made once, then
+  reused."""
+  babbled_home(tmp_path_factory.getbasetemp() / "agents_home")
 
 
 def episode(agent_name, robot, task, seed=0):
@@ -47,10 +48,14 @@ def episode(agent_name, robot, task, seed=0):
 @pytest.mark.parametrize("robot,task", TASKS)
 @pytest.mark.parametrize("agent_name", agents.AGENTS)
 class TestEveryAgent:
+  @pytest.fixture(autouse=True)
+  def trained_once_per_run(self, robot, run_wide_home):
+    run_wide_home(robot)
+
   def test_actions_are_finite_in_bounds_and_the_same_for_a_seed(self, agent_name, robot, task):
     # A learned agent is made again from its cached checkpoint the second time; training itself
     # is checked by test_training_is_deterministic_and_its_checkpoint_round_trips.
-    first, second = episode(agent_name, robot, task, 1), episode(agent_name, robot, task, 1)
+    first, second = episode(agent_name, robot, task), episode(agent_name, robot, task)
     assert first.actions.shape == (EPISODE_STEPS, robots.make(robot).action_dim)
     assert np.all(np.isfinite(first.actions)) and np.all(np.abs(first.actions) <= 1.0)
     np.testing.assert_array_equal(first.actions, second.actions)

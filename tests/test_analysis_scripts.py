@@ -22,8 +22,10 @@ ANALYSIS = pathlib.Path(__file__).parent.parent / "docs" / "analysis"
 
 
 @pytest.fixture(autouse=True)
-def data_home(tmp_path, monkeypatch):
-  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
+def data_home(tmp_path, babbled_home):
+  """A data home of each test's own, holding the tiny datasets of the robots the scripts use."""
+  for robot in ("tendon-1", "tendon-2", "tendon-local-2"):
+    babbled_home(tmp_path, robot)
 
 
 def run_script(name: str, arguments: list[str], monkeypatch, capsys) -> str:

@@ -25,9 +25,10 @@ STEPS_BEFORE = 60  # Physics steps under a random action, so that forces are rea
 
 
 @pytest.fixture(autouse=True)
-def shared_home(tmp_path_factory, monkeypatch):
-  """One data home for the file: datasets and checkpoints are made once, then reused."""
-  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path_factory.getbasetemp() / "faults_home"))
+def shared_home(tmp_path_factory, babbled_home):
+  """One data home for the file, holding tendon-2's tiny dataset: the faulty robots' datasets and
+  the checkpoints are made once, then reused."""
+  babbled_home(tmp_path_factory.getbasetemp() / "faults_home")
 
 
 def _test_faults(robot: robots.SoftArm) -> tuple[faults.Fault, ...]:

@@ -15,8 +15,10 @@ TINY_INVERSE = training.InverseTrainingConfig(max_epochs=2, patience=2)
 
 
 @pytest.fixture(autouse=True)
-def data_home(tmp_path_factory, monkeypatch):
-  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path_factory.getbasetemp() / "protocols_home"))
+def data_home(tmp_path_factory, babbled_home):
+  """One data home for the file, holding the tiny datasets of the robots its protocols learn."""
+  for robot in ("tendon-1", "tendon-2", "pneumatic-433"):
+    babbled_home(tmp_path_factory.getbasetemp() / "protocols_home", robot)
 
 
 def test_the_paper_protocols_have_the_papers_columns():

@@ -21,8 +21,8 @@ TINY = profiles.get("tiny")
 
 
 @pytest.fixture
-def home(tmp_path, monkeypatch):
-  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / "home"))
+def home(tmp_path, monkeypatch, babbled_home):
+  babbled_home(tmp_path / "home", ROBOT)
   monkeypatch.setattr(sac, "CHUNK_STEPS", 50)  # Two chunks in the tiny profile's 100 steps.
   monkeypatch.setattr(snapshots, "SAVE_INTERVAL_S", 0.0)  # Save after every chunk.
   return tmp_path / "home"
@@ -34,12 +34,14 @@ def _weights(trained: dict) -> dict[str, torch.Tensor]:
   return stable_baselines3.SAC.load(io.BytesIO(trained["model"])).policy.state_dict()
 
 
-def test_an_interrupted_training_resumes_to_the_same_weights(home, tmp_path, monkeypatch):
+def test_an_interrupted_training_resumes_to_the_same_weights(
+  home, tmp_path, monkeypatch, babbled_home
+):
   arm = robots.make(ROBOT)
   whole = sac.train(arm, 0, TINY)
   assert whole["environment_steps"] == sac.STEPS["tiny"]
   assert whole["episodes"] == sac.STEPS["tiny"] // sac.EPISODE_STEPS + 1  # The next one begun.
-  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / "other"))
+  babbled_home(tmp_path / "other", ROBOT)
   learn, calls = stable_baselines3.SAC.learn, []
 
   def interrupted_in_the_second_chunk(model, *args, **kwargs):

@@ -10,6 +10,7 @@ import json
 import os
 import pathlib
 import re
+import shutil
 import signal
 import threading
 import time
@@ -30,6 +31,7 @@ from softbench import storage
 from softbench import sweep
 from softbench import zoo
 from softbench.agents import learned
+from softbench.data import dataset
 from softbench.sweep import display
 from softbench.sweep import grid as sweep_grid
 
@@ -57,11 +59,14 @@ def address():
 
 
 @pytest.fixture(scope="module")
-def expected(tmp_path_factory) -> dict[str, dict]:
+def expected(tmp_path_factory, babbled_datasets) -> dict[str, dict]:
   """``softbench run``'s record of every setting of GRID, by name, as its file holds it (run in a
-  data home of its own)."""
+  data home of its own, given the tiny datasets; the sweep's own home is not)."""
+  home = tmp_path_factory.mktemp("run-home")
+  for robot in GRID.robots:
+    shutil.copytree(babbled_datasets(robot), home / dataset.DATASETS_FOLDER, dirs_exist_ok=True)
   with pytest.MonkeyPatch.context() as patch:
-    patch.setenv(storage.HOME_VARIABLE, str(tmp_path_factory.mktemp("run-home")))
+    patch.setenv(storage.HOME_VARIABLE, str(home))
     patch.setenv(zoo.VARIABLE, zoo.OFF)
     return {
       sweep_grid.setting_name(settings): json.loads(
@@ -221,7 +226,9 @@ def test_an_interrupted_sweep_resumes_to_the_records_softbench_run_writes(
   assert run_sweep(GRID, results, address).written == ()  # Nothing left: Ray is not started.
 
 
-def test_exp1s_in_a_sweep_writes_the_record_softbench_run_writes(address, tmp_path):
+def test_exp1s_in_a_sweep_writes_the_record_softbench_run_writes(
+  address, tmp_path, babbled_datasets
+):
   tiny, family = profiles.get("tiny"), "tendon-local"
   only_exp1s = sweep.Grid((), (), (), "tiny", 1, families=(family,))
   with (
@@ -229,6 +236,12 @@ def test_exp1s_in_a_sweep_writes_the_record_softbench_run_writes(address, tmp_pa
     ray_with_worker_hook(address, worker_hooks.shorten_exp1s),
   ):
     patch.setitem(protocols.PROTOCOLS, continual.PROTOCOL, worker_hooks.shortened_exp1s())
+    for stage in continual.protocol(family).robot_names:  # Given to softbench run's home only.
+      shutil.copytree(
+        babbled_datasets(stage),
+        tmp_path / "run-home" / dataset.DATASETS_FOLDER,
+        dirs_exist_ok=True,
+      )
     with pytest.MonkeyPatch.context() as home:  # softbench run's record, in a home of its own.
       home.setenv(storage.HOME_VARIABLE, str(tmp_path / "run-home"))
       expected = records.seal(continual.execute(tiny, 1, False, workers=1, family=family))

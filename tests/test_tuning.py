@@ -19,9 +19,9 @@ LEARNED = agents.babbling_learners()  # The agents tuning takes.
 
 
 @pytest.fixture(autouse=True)
-def shared_home(tmp_path_factory, monkeypatch):
-  """One data home for the file: the tiny dataset and forward models are made once."""
-  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path_factory.getbasetemp() / "tuning_home"))
+def shared_home(tmp_path_factory, babbled_home):
+  """One data home for the file, holding tendon-2's tiny dataset: forward models are made once."""
+  babbled_home(tmp_path_factory.getbasetemp() / "tuning_home")
 
 
 def tune(tmp_path, *options, agent="mlp", trials=2):
@@ -153,8 +153,8 @@ def test_a_changed_value_changes_the_checkpoint_key(agent, tmp_path, monkeypatch
   assert key() != before
 
 
-def test_learned_agents_train_with_the_committed_values(tmp_path, monkeypatch):
-  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path / "home"))
+def test_learned_agents_train_with_the_committed_values(tmp_path, monkeypatch, babbled_home):
+  babbled_home(tmp_path / "home")
   agents.make("mlp", "tendon-2", 0, "tiny")
   table = json.loads(hyperparameters.PATH.read_text())
   table["agents"]["mlp"]["tendon-3"]["params"]["hidden_size"] = 32

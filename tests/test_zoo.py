@@ -60,16 +60,17 @@ def no_training(monkeypatch):
 
 
 @pytest.fixture(scope="module")
-def trained_zoos(tmp_path_factory, babbled):
-  """Per learned agent (made on first use): a zoo of its tiny seed-0 weights, trained in a home
-  of its own, and the trained agent's actions."""
+def trained_zoos(tmp_path_factory, run_wide_homes):
+  """Per learned agent (made on first use): a zoo of its tiny seed-0 weights, trained in the run's
+  home of ROBOT (test_agents_and_run's ``TestEveryAgent`` trains the same), and the trained
+  agent's actions."""
   made = {}
 
   def get(agent_name):
     if agent_name not in made:
       base = tmp_path_factory.mktemp(f"zoo-{agent_name}")
       with pytest.MonkeyPatch.context() as patched:
-        use(patched, base / "trained", datasets=babbled)
+        use(patched, run_wide_homes(ROBOT))
         trained = actions(agent_name)
         chosen = catalogue.setting(agent_name, ROBOT, None, "tiny", 1)
         zoo.add([(path, kind) for _, path, kind in catalogue.cache_files(chosen)], {}, base / "zoo")
@@ -106,7 +107,7 @@ def test_an_empty_data_home_takes_the_zoos_weights_instead_of_training(
 
 
 def test_a_tampered_zoo_file_is_refused_in_one_line_and_the_agent_trained(
-  zoo_of, tmp_path, monkeypatch
+  zoo_of, babbled, tmp_path, monkeypatch
 ):
   # The zoo checks bytes, whatever the agent: one agent shows it.
   agent_name = "mlp"
@@ -115,7 +116,7 @@ def test_a_tampered_zoo_file_is_refused_in_one_line_and_the_agent_trained(
   content = bytearray(checkpoint.read_bytes())
   content[len(content) // 2] ^= 1  # One bit of the weights.
   checkpoint.write_bytes(bytes(content))
-  use(monkeypatch, tmp_path / "empty", folder)
+  use(monkeypatch, tmp_path / "untrained", folder, datasets=babbled)
   with pytest.warns(zoo.ZooWarning) as caught:
     retrained = actions(agent_name)
   (warning,) = [entry for entry in caught if issubclass(entry.category, zoo.ZooWarning)]
