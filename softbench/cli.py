@@ -439,24 +439,24 @@ def _tune_arguments(parser: argparse.ArgumentParser) -> None:
 def _run_arguments(parser: argparse.ArgumentParser) -> None:
   from softbench import adaptive
   from softbench import agents
-  from softbench import continual
   from softbench import robots
   from softbench import suite
+  from softbench.records import exp1s as exp1s_records
 
   parser.add_argument("--task", help=f"one of {', '.join(suite.TASKS)}")
   parser.add_argument(
     "--protocol",
-    help=f"{continual.PROTOCOL}: SMPL learns tendon-1 .. "
+    help=f"{exp1s_records.PROTOCOL}: SMPL learns tendon-1 .. "
     f"tendon-5 (or another --family's arms) in sequence; "
     f"prints the paper's Exp1S table and the forgetting "
     f"matrix",
   )
   parser.add_argument(
     "--family",
-    help=f"with --protocol {continual.PROTOCOL}: the tendon "
+    help=f"with --protocol {exp1s_records.PROTOCOL}: the tendon "
     f"family whose arms 1 .. 5 SMPL learns, one of "
     f"{', '.join(robots.TENDON_FAMILIES)} (default "
-    f"{continual.DEFAULT_FAMILY})",
+    f"{exp1s_records.DEFAULT_FAMILY})",
   )
   parser.add_argument("--agent", required=True, help=f"one of {', '.join(agents.AGENTS)}")
   parser.add_argument(
@@ -513,9 +513,9 @@ def _run_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _sweep_arguments(parser: argparse.ArgumentParser) -> None:
   from softbench import agents
-  from softbench import continual
   from softbench import robots
   from softbench import suite
+  from softbench.records import exp1s as exp1s_records
 
   parser.add_argument(
     "--robots", nargs="+", default=[], metavar="ROBOT", help="e.g. tendon-1 tendon-3"
@@ -528,15 +528,15 @@ def _sweep_arguments(parser: argparse.ArgumentParser) -> None:
   )
   parser.add_argument(
     "--protocol",
-    help=f"{continual.PROTOCOL}: also SMPL's Exp1S on each of --families (then --robots, "
+    help=f"{exp1s_records.PROTOCOL}: also SMPL's Exp1S on each of --families (then --robots, "
     "--tasks and --agents may be left out)",
   )
   parser.add_argument(
     "--families",
     nargs="+",
     metavar="FAMILY",
-    help=f"with --protocol {continual.PROTOCOL}: of {', '.join(robots.TENDON_FAMILIES)} "
-    f"(default {continual.DEFAULT_FAMILY})",
+    help=f"with --protocol {exp1s_records.PROTOCOL}: of {', '.join(robots.TENDON_FAMILIES)} "
+    f"(default {exp1s_records.DEFAULT_FAMILY})",
   )
   _add_profile_argument(parser)
   parser.add_argument("--seeds", type=int, help="number of seeds (default: the profile's)")
@@ -631,9 +631,9 @@ def _retrain_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _zoo_arguments(parser: argparse.ArgumentParser) -> None:
-  from softbench import continual
   from softbench import robots
   from softbench import zoo
+  from softbench.records import exp1s as exp1s_records
 
   zoo_commands = parser.add_subparsers(dest="zoo_command", required=True)
   zoo_help = f"the zoo folder (default ${zoo.VARIABLE}, else zoo/ of the checkout)"
@@ -649,10 +649,12 @@ def _zoo_arguments(parser: argparse.ArgumentParser) -> None:
   )
   add_parser.add_argument("--agent", help="a learned agent")
   add_parser.add_argument("--robot", help="the robot it was trained on")
-  add_parser.add_argument("--protocol", help=f"{continual.PROTOCOL}: the Exp1S networks instead")
+  add_parser.add_argument(
+    "--protocol", help=f"{exp1s_records.PROTOCOL}: the Exp1S networks instead"
+  )
   add_parser.add_argument(
     "--family",
-    help=f"with --protocol {continual.PROTOCOL}: one of {', '.join(robots.TENDON_FAMILIES)}",
+    help=f"with --protocol {exp1s_records.PROTOCOL}: one of {', '.join(robots.TENDON_FAMILIES)}",
   )
   add_parser.add_argument("--seeds", type=int, help="seeds 0 .. N-1 (default: the profile's)")
   _add_profile_argument(add_parser)

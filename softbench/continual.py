@@ -46,6 +46,7 @@ from softbench.agents import hyperparameters
 from softbench.agents import learned
 from softbench.data import dataset
 from softbench.records import provenance
+from softbench.records.exp1s import DEFAULT_FAMILY
 from softbench.records.exp1s import FORGETTING_TASK
 from softbench.records.exp1s import FORMAT as RECORD_FORMAT
 from softbench.records.exp1s import LOOPS
@@ -53,8 +54,6 @@ from softbench.records.exp1s import METRICS
 from softbench.records.exp1s import PROTOCOL
 from softbench.records.exp1s import TASKS
 from softbench.records.exp1s import VERSION as RECORD_VERSION
-
-DEFAULT_FAMILY = "tendon"
 
 
 def protocol(family: str = DEFAULT_FAMILY) -> protocols.Protocol:

@@ -31,6 +31,9 @@ from softbench import robots
 from softbench import saving
 from softbench import suite
 from softbench import zoo
+from softbench.adaptive import experiment as adaptive_experiment
+from softbench.adaptive import report as adaptive_report
+from softbench.adaptive import runner as adaptive_runner
 from softbench.agents import learned
 from softbench.data import dataset
 from softbench.records import provenance
@@ -176,7 +179,7 @@ def _helpers(run: RunSettings, helpers: str | None) -> str | None:
     ValueError: unknown ``helpers``, or ``helpers`` where nothing is completed (one line).
   """
   if helpers is not None:
-    adaptive_activation.experiment.check_helpers(helpers)
+    adaptive_experiment.check_helpers(helpers)
   if suite.gives_whole_targets(run.robot, run.task, **task_options(run)):
     if helpers is not None:
       raise ValueError(f"--helpers completes partial targets; task {run.task!r} gives whole ones")
@@ -419,7 +422,7 @@ def execute_episodes(
       run.robot, samples=run.profile.samples, seed=learned.DATA_SEED, progress=show_progress
     )
   if run.adaptive:
-    section = adaptive_activation.run(
+    section = adaptive_runner.run(
       run.robot,
       run.agent,
       run.profile,
@@ -506,7 +509,7 @@ def table(record: dict) -> str:
   """The printed table: rows per scored module and their mean, columns per metric (an adaptive
   run: ``softbench.adaptive.report.table``)."""
   if "adaptive" in record:
-    return adaptive_activation.report.table(record)
+    return adaptive_report.table(record)
   measured = [(name, label) for name, label in METRICS if name in record["per_seed"][0]]
   columns = {name: summary(record, name) for name, _ in measured}
   rows = [f"module {module}" for module in record["scored_modules"]] + ["mean"]

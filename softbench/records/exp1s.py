@@ -19,6 +19,7 @@ from softbench.records.fields import METRICS
 FORMAT = "softbench-exp1s-result"
 VERSION = 2  # 2: sealed with an integrity hash.
 PROTOCOL = "exp1s"
+DEFAULT_FAMILY = "tendon"  # The paper's Exp1S: tendon-1 .. tendon-5, cables routed through.
 TASKS = ("babbling", "circle", "rectangle", "spiral")  # The paper's Exp1S table.
 LOOPS = {"closed": "physics", "open": "open-loop"}  # Table label -> the agent's error source.
 FORGETTING_TASK = "spiral"

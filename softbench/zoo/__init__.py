@@ -31,8 +31,6 @@ import pathlib
 import sys
 import warnings
 
-import torch
-
 from smpl.files import first_line
 from softbench import storage
 
@@ -241,6 +239,8 @@ def _copy_checked(zoo: pathlib.Path, entry: Entry, home: pathlib.Path) -> bool:
 
 def stored_config(path: pathlib.Path) -> dict:
   """The configuration a checkpoint file was saved with (``smpl.checkpoint``), or {}."""
+  import torch  # pylint: disable=import-outside-toplevel  (only here: `zoo list` runs without it)
+
   try:
     payload = torch.load(path, map_location="cpu", weights_only=True)
     return dict(payload["config"])
