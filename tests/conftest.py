@@ -45,32 +45,42 @@ def babbled_datasets(run_folder):
   (data seed ``learned.DATA_SEED``), collected once per test run: collecting it took most of a
   tiny training's time. Test processes share that data home as users' processes do (the first
   collects, the others wait for it and read it; their waiting line is not shown)."""
+  collected = {}
 
   def of(robot: str):
-    template = run_folder / f"babbled-{robot}"
-    with pytest.MonkeyPatch.context() as patched, contextlib.redirect_stderr(io.StringIO()):
-      patched.setenv("SOFTBENCH_HOME", str(template))
-      data.collect(
-        robot, samples=profiles.get("tiny").samples, seed=learned.DATA_SEED, progress=False
-      )
-    return template / data_files.DATASETS_FOLDER
+    if robot not in collected:
+      template = run_folder / f"babbled-{robot}"
+      with pytest.MonkeyPatch.context() as patched, contextlib.redirect_stderr(io.StringIO()):
+        patched.setenv("SOFTBENCH_HOME", str(template))
+        data.collect(
+          robot, samples=profiles.get("tiny").samples, seed=learned.DATA_SEED, progress=False
+        )
+      collected[robot] = template / data_files.DATASETS_FOLDER
+    return collected[robot]
 
   return of
 
 
+@pytest.fixture(scope="session")
+def with_babbled_dataset(babbled_datasets):
+  """``give(home, robot="tendon-2")``: copies ``babbled_datasets(robot)`` into data home ``home``
+  (which stays whatever the data home was); ``home``."""
+
+  def give(home, robot="tendon-2"):
+    shutil.copytree(babbled_datasets(robot), home / data_files.DATASETS_FOLDER, dirs_exist_ok=True)
+    return home
+
+  return give
+
+
 @pytest.fixture
-def babbled_home(monkeypatch, babbled_datasets):
+def babbled_home(monkeypatch, with_babbled_dataset):
   """``into(home, robot="tendon-2")``: makes ``home`` the data home, with a copy of
   ``babbled_datasets``. For tests of what is trained in a home of its own; the dataset's own
   determinism and caching are test_data's subject."""
 
   def into(home, robot="tendon-2"):
-    shutil.copytree(
-      babbled_datasets(robot),
-      home / data_files.DATASETS_FOLDER,
-      dirs_exist_ok=True,
-    )
-    monkeypatch.setenv("SOFTBENCH_HOME", str(home))
+    monkeypatch.setenv("SOFTBENCH_HOME", str(with_babbled_dataset(home, robot)))
     return home
 
   return into

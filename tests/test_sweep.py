@@ -10,7 +10,6 @@ import json
 import os
 import pathlib
 import re
-import shutil
 import signal
 import threading
 import time
@@ -31,7 +30,6 @@ from softbench import storage
 from softbench import sweep
 from softbench import zoo
 from softbench.agents import learned
-from softbench.data import dataset
 from softbench.sweep import display
 from softbench.sweep import grid as sweep_grid
 
@@ -59,12 +57,12 @@ def address():
 
 
 @pytest.fixture(scope="module")
-def expected(tmp_path_factory, babbled_datasets) -> dict[str, dict]:
+def expected(tmp_path_factory, with_babbled_dataset) -> dict[str, dict]:
   """``softbench run``'s record of every setting of GRID, by name, as its file holds it (run in a
   data home of its own, given the tiny datasets; the sweep's own home is not)."""
   home = tmp_path_factory.mktemp("run-home")
   for robot in GRID.robots:
-    shutil.copytree(babbled_datasets(robot), home / dataset.DATASETS_FOLDER, dirs_exist_ok=True)
+    with_babbled_dataset(home, robot)
   with pytest.MonkeyPatch.context() as patch:
     patch.setenv(storage.HOME_VARIABLE, str(home))
     patch.setenv(zoo.VARIABLE, zoo.OFF)
@@ -227,7 +225,7 @@ def test_an_interrupted_sweep_resumes_to_the_records_softbench_run_writes(
 
 
 def test_exp1s_in_a_sweep_writes_the_record_softbench_run_writes(
-  address, tmp_path, babbled_datasets
+  address, tmp_path, with_babbled_dataset
 ):
   tiny, family = profiles.get("tiny"), "tendon-local"
   only_exp1s = sweep.Grid((), (), (), "tiny", 1, families=(family,))
@@ -237,11 +235,7 @@ def test_exp1s_in_a_sweep_writes_the_record_softbench_run_writes(
   ):
     patch.setitem(protocols.PROTOCOLS, continual.PROTOCOL, worker_hooks.shortened_exp1s())
     for stage in continual.protocol(family).robot_names:  # Given to softbench run's home only.
-      shutil.copytree(
-        babbled_datasets(stage),
-        tmp_path / "run-home" / dataset.DATASETS_FOLDER,
-        dirs_exist_ok=True,
-      )
+      with_babbled_dataset(tmp_path / "run-home", stage)
     with pytest.MonkeyPatch.context() as home:  # softbench run's record, in a home of its own.
       home.setenv(storage.HOME_VARIABLE, str(tmp_path / "run-home"))
       expected = records.seal(continual.execute(tiny, 1, False, workers=1, family=family))
