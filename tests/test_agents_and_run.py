@@ -19,6 +19,7 @@ from softbench import profiles
 from softbench import protocols
 from softbench import robots
 from softbench import run
+from softbench import storage
 from softbench import suite
 from softbench import terminal
 from softbench.agents import forward_models
@@ -63,18 +64,20 @@ class TestEveryAgent:
 
 @pytest.mark.parametrize("agent_name", LEARNED_AGENTS)
 def test_training_is_deterministic_and_its_checkpoint_round_trips(
-  agent_name, tmp_path, babbled_home, assert_one_line_retraining
+  agent_name, tmp_path, babbled_home, run_wide_home, assert_one_line_retraining
 ):
-  """Trained in one data home, then made again from its checkpoint: the same actions; a damaged
-  checkpoint is reported in one line and trained again, to the same weights. Trained from scratch
-  in a second data home (no model cached; the babbling dataset is, copied: its collection's
-  determinism is test_data's): the same seed gives the same actions, another seed others."""
-  babbled_home(tmp_path / "first")
+  """Trained in a data home that holds only the babbling dataset (copied: its collection's
+  determinism is test_data's), then made again from its checkpoint: the same actions. A damaged
+  checkpoint, its forward models gone too, is reported in one line and trained again from
+  scratch, to the same actions. Another seed (the run-wide home's seed 0) acts otherwise."""
+  babbled_home(tmp_path)
   trained = episode(agent_name, "tendon-2", "circle", 1)  # Trains, then saves the checkpoint.
-  (checkpoint,) = (tmp_path / "first" / learned.CHECKPOINT_FOLDER).glob(f"{agent_name}-*.pt")
+  (checkpoint,) = (tmp_path / learned.CHECKPOINT_FOLDER).glob(f"{agent_name}-*.pt")
   loaded = episode(agent_name, "tendon-2", "circle", 1)
   np.testing.assert_array_equal(trained.actions, loaded.actions)
   checkpoint.write_bytes(checkpoint.read_bytes()[:1000])
+  if (tmp_path / forward_models.FOLDER).exists():  # sac learns without forward models.
+    shutil.rmtree(tmp_path / forward_models.FOLDER)
   with pytest.warns(data.CorruptFileWarning) as caught:
     retrained = episode(agent_name, "tendon-2", "circle", 1)
   assert_one_line_retraining(caught, checkpoint)
@@ -85,11 +88,8 @@ def test_training_is_deterministic_and_its_checkpoint_round_trips(
       episode(agent_name, "tendon-2", "circle", 1).actions, trained.actions
     )
   assert [path.name for path in checkpoint.parent.iterdir()] == [checkpoint.name]
-  babbled_home(tmp_path / "second")
-  np.testing.assert_array_equal(
-    episode(agent_name, "tendon-2", "circle", 1).actions, trained.actions
-  )
-  assert not np.array_equal(episode(agent_name, "tendon-2", "circle", 2).actions, trained.actions)
+  run_wide_home("tendon-2")  # Its agents are trained once per run (TestEveryAgent's).
+  assert not np.array_equal(episode(agent_name, "tendon-2", "circle", 0).actions, trained.actions)
 
 
 @pytest.mark.parametrize("damage", ["hello", "flipped weight"])
@@ -138,24 +138,27 @@ def test_a_folder_at_a_checkpoint_path_is_damage_reported_and_replaced(
 
 @pytest.mark.parametrize("agent_name", agents.babbling_learners())  # sac: in test_sac.
 def test_interrupted_training_resumes_to_the_same_checkpoint(
-  agent_name, interrupted_training, tmp_path, babbled_home
+  agent_name, interrupted_training, tmp_path, babbled_home, run_wide_home
 ):
+  """Trained from scratch, interrupted, then resumed: the checkpoint of the run-wide home's
+  uninterrupted training, bit for bit (its name is the same: paths are not part of the key)."""
   babbled_home(tmp_path)
-  agents.make(agent_name, "tendon-2", 0, "tiny")
-  (checkpoint,) = (tmp_path / learned.CHECKPOINT_FOLDER).glob(f"{agent_name}-*.pt")
-  uninterrupted = torch.load(checkpoint, weights_only=False)["state_dict"]
-  checkpoint.unlink()
-  shutil.rmtree(tmp_path / forward_models.FOLDER)  # From scratch: the forward models too.
   with interrupted_training():
     agents.make(agent_name, "tendon-2", 0, "tiny")
   # The fit under way kept a snapshot: an inverse model's in the checkpoint's folder, or (SMPL,
   # with a forward model per module) a forward model's in its cache file's folder.
   assert list(tmp_path.rglob("*.partial/fit-1.pt"))
   agents.make(agent_name, "tendon-2", 0, "tiny")
+  (checkpoint,) = (tmp_path / learned.CHECKPOINT_FOLDER).glob(f"{agent_name}-*.pt")
   resumed = torch.load(checkpoint, weights_only=False)["state_dict"]
+  assert not list(tmp_path.rglob("*.partial"))
+  run_wide_home("tendon-2")  # Its agents are trained once per run.
+  agents.make(agent_name, "tendon-2", 0, "tiny")
+  uninterrupted = torch.load(
+    storage.softbench_home() / learned.CHECKPOINT_FOLDER / checkpoint.name, weights_only=False
+  )["state_dict"]
   assert resumed.keys() == uninterrupted.keys()
   assert all(torch.equal(resumed[key], uninterrupted[key]) for key in resumed)
-  assert not list(tmp_path.rglob("*.partial"))
 
 
 def test_agents_reading_the_same_view_share_one_forward_model(tmp_path, monkeypatch, babbled_home):
