@@ -330,6 +330,18 @@ def _zoo_add(args: argparse.Namespace) -> None:
   print(zoo_listing.additions(added, skipped, folder, unchecked))
 
 
+def _zoo_remove(args: argparse.Namespace) -> None:
+  from softbench import zoo
+  from softbench.leaderboard import zoo_catalogue
+  from softbench.zoo import listing as zoo_listing
+
+  chosen = zoo_catalogue.requested_setting(
+    args.agent, args.robot, args.protocol, args.family, args.profile, args.seeds
+  )
+  folder = zoo.chosen_folder(args.zoo)
+  print(zoo_listing.removals(zoo_catalogue.remove(chosen, folder), folder))
+
+
 def _zoo_verify(args: argparse.Namespace) -> None:
   from softbench import zoo
   from softbench.leaderboard import zoo_verification
@@ -630,10 +642,24 @@ def _retrain_arguments(parser: argparse.ArgumentParser) -> None:
   _add_record_arguments(parser)
 
 
-def _zoo_arguments(parser: argparse.ArgumentParser) -> None:
+def _add_zoo_setting_arguments(parser: argparse.ArgumentParser) -> None:
+  """The setting of ``zoo add`` and ``zoo remove``: an agent on a robot, or Exp1S on a family."""
   from softbench import robots
-  from softbench import zoo
   from softbench.records import exp1s as exp1s_records
+
+  parser.add_argument("--agent", help="a learned agent")
+  parser.add_argument("--robot", help="the robot it was trained on")
+  parser.add_argument("--protocol", help=f"{exp1s_records.PROTOCOL}: the Exp1S networks instead")
+  parser.add_argument(
+    "--family",
+    help=f"with --protocol {exp1s_records.PROTOCOL}: one of {', '.join(robots.TENDON_FAMILIES)}",
+  )
+  parser.add_argument("--seeds", type=int, help="seeds 0 .. N-1 (default: the profile's)")
+  _add_profile_argument(parser)
+
+
+def _zoo_arguments(parser: argparse.ArgumentParser) -> None:
+  from softbench import zoo
 
   zoo_commands = parser.add_subparsers(dest="zoo_command", required=True)
   zoo_help = f"the zoo folder (default ${zoo.VARIABLE}, else zoo/ of the checkout)"
@@ -647,17 +673,7 @@ def _zoo_arguments(parser: argparse.ArgumentParser) -> None:
     "zoo, or the saved state of a training still under way, and links the records "
     "in --results that they made: those whose weights section names these files' sha256.",
   )
-  add_parser.add_argument("--agent", help="a learned agent")
-  add_parser.add_argument("--robot", help="the robot it was trained on")
-  add_parser.add_argument(
-    "--protocol", help=f"{exp1s_records.PROTOCOL}: the Exp1S networks instead"
-  )
-  add_parser.add_argument(
-    "--family",
-    help=f"with --protocol {exp1s_records.PROTOCOL}: one of {', '.join(robots.TENDON_FAMILIES)}",
-  )
-  add_parser.add_argument("--seeds", type=int, help="seeds 0 .. N-1 (default: the profile's)")
-  _add_profile_argument(add_parser)
+  _add_zoo_setting_arguments(add_parser)
   _add_results_argument(add_parser, "folder of the records to link")
   add_parser.add_argument(
     "--link-unchecked",
@@ -667,6 +683,15 @@ def _zoo_arguments(parser: argparse.ArgumentParser) -> None:
   )
   add_parser.add_argument("--zoo", help=zoo_help)
   add_parser.set_defaults(run=_zoo_add)
+  remove_parser = zoo_commands.add_parser(
+    "remove",
+    help="remove a setting's weights (or unfinished training) from the zoo",
+    description="Removes each seed's checkpoint, or the saved state of its unfinished "
+    "training, and the forward models that no other agent in the zoo reads.",
+  )
+  _add_zoo_setting_arguments(remove_parser)
+  remove_parser.add_argument("--zoo", help=zoo_help)
+  remove_parser.set_defaults(run=_zoo_remove)
   verify_parser = zoo_commands.add_parser(
     "verify",
     help="re-score records from the zoo alone and compare them",

@@ -206,6 +206,38 @@ def test_the_zoo_refuses_to_outgrow_its_budget(babbled, zoo_of, tmp_path, monkey
   assert not list(folder.glob(f"{learned.CHECKPOINT_FOLDER}/lstm-*"))
 
 
+def test_removing_an_agent_keeps_the_forward_models_that_another_agent_in_the_zoo_reads(
+  run_wide_homes, tmp_path, monkeypatch, capsys
+):
+  # One zoo of every learned agent's seed-0 weights (trained once per run in the run's home of
+  # ROBOT), emptied one agent at a time through the command line.
+  folder = tmp_path / "zoo"
+  use(monkeypatch, run_wide_homes(ROBOT))
+  files_of = {}
+  for agent_name in LEARNED_AGENTS:
+    agents.make(agent_name, ROBOT, 0, "tiny")
+    files_of[agent_name] = catalogue.cache_files(
+      catalogue.setting(agent_name, ROBOT, None, "tiny", 1)
+    )
+    zoo.add([(path, kind) for _, path, kind in files_of[agent_name]], {}, folder)
+  relative = lambda path: path.relative_to(run_wide_homes(ROBOT)).as_posix()
+  argv = ["--robot", ROBOT, "--profile", "tiny", "--seeds", "1", "--zoo", str(folder)]
+  for done, agent_name in enumerate(LEARNED_AGENTS):
+    capsys.readouterr()
+    assert cli.main(["zoo", "remove", "--agent", agent_name, *argv]) == 0
+    removed = {line.split()[1] for line in capsys.readouterr().out.splitlines()[:-1]}
+    left = zoo.read_manifest(folder)
+    kept = {relative(path) for name in LEARNED_AGENTS[done + 1 :] for _, path, _ in files_of[name]}
+    own = {relative(path) for _, path, _ in files_of[agent_name]}
+    assert kept <= set(left) and own - kept <= removed and not removed & set(left)
+    assert zoo.check_files(folder) == []  # Every listed file is there, and nothing else.
+    assert cli.main(["zoo", "remove", "--agent", agent_name, *argv]) == cli.EXIT_USAGE
+    error = capsys.readouterr().err
+    assert "holds nothing of" in error and error.count("\n") == 1
+  assert zoo.read_manifest(folder) == {}
+  assert [path.name for path in folder.rglob("*")] == [zoo.MANIFEST]
+
+
 def run_command(results, seeds=2):
   return [
     "run",
@@ -376,6 +408,7 @@ def test_a_record_naming_weights_of_a_seed_it_lacks_is_refused(babbled, tmp_path
     _reseal(record, path)
 
 
+@pytest.mark.parametrize("command", ["add", "remove"])
 @pytest.mark.parametrize(
   "argv,message",
   [
@@ -386,13 +419,16 @@ def test_a_record_naming_weights_of_a_seed_it_lacks_is_refused(babbled, tmp_path
     (["--protocol", "exp2s"], "unknown protocol"),
     (["--family", "tendon-local"], "--family goes with --protocol"),
     (["--agent", "lstm", "--robot", ROBOT, "--seeds", "0"], "at least 1"),
-    (["--agent", "lstm", "--robot", ROBOT], "nothing of this setting is trained"),
+    (["--agent", "lstm", "--robot", ROBOT], "nothing of"),  # Trained (add), in the zoo (remove).
   ],
 )
-def test_zoo_add_refuses_bad_input_in_one_line(argv, message, tmp_path, monkeypatch, capsys):
+def test_zoo_add_and_remove_refuse_bad_input_in_one_line(
+  command, argv, message, tmp_path, monkeypatch, capsys
+):
   use(monkeypatch, tmp_path / "home")
+  (tmp_path / "zoo").mkdir()
   assert (
-    cli.main(["zoo", "add", *argv, "--profile", "tiny", "--zoo", str(tmp_path / "zoo")])
+    cli.main(["zoo", command, *argv, "--profile", "tiny", "--zoo", str(tmp_path / "zoo")])
     == cli.EXIT_USAGE
   )
   error = capsys.readouterr().err

@@ -1,6 +1,6 @@
 """What the zoo keeps for a setting: the cache files of a learned agent's seeds (or of Exp1S's
 networks), the committed records each of them stands behind (those whose ``weights`` section
-names these files' sha256), and adding them to the zoo."""
+names these files' sha256), and adding them to the zoo or removing them."""
 
 import dataclasses
 import pathlib
@@ -10,6 +10,7 @@ from softbench import continual
 from softbench import profiles
 from softbench import records
 from softbench import robots
+from softbench import storage
 from softbench import zoo
 from softbench.agents import learned
 from softbench.records import fields as record_fields
@@ -187,3 +188,45 @@ def add(
     zoo_folder,
   )
   return added, skipped, links.unchecked
+
+
+def _sharing_forward_models(chosen: Setting) -> list[Setting]:
+  """The other settings whose agents may read ``chosen``'s forward models: every other agent
+  trained on babbling, on the same robot at the same profile and seeds (none for Exp1S)."""
+  if chosen.family is not None:
+    return []
+  return [
+    dataclasses.replace(chosen, agent=other)
+    for other in agents.babbling_learners()
+    if other != chosen.agent
+  ]
+
+
+def remove(chosen: Setting, zoo_folder: pathlib.Path) -> list[zoo.Entry]:
+  """``zoo.remove`` of what the zoo holds of the setting: each seed's checkpoint or unfinished
+  training, and the forward models that no other agent in the zoo reads; returns the entries
+  removed.
+
+  Raises:
+    ValueError: the zoo holds nothing of the setting (one line; nothing is changed).
+  """
+  entries = zoo.read_manifest(zoo_folder)
+  home = storage.softbench_home()
+
+  def held(path: pathlib.Path) -> set[str]:
+    return zoo.held_for(path.relative_to(home).as_posix(), entries)
+
+  own = cache_files(chosen)
+  if not any(held(path) for _, path, kind in own if kind == "agent"):
+    raise ValueError(f"the zoo {zoo_folder} holds nothing of {chosen.label}")
+  still_read = set()
+  for other in _sharing_forward_models(chosen):
+    files = cache_files(other)
+    in_zoo = {seed for seed, path, kind in files if kind == "agent" and held(path)}
+    still_read |= {
+      path
+      for seed, file, kind in files
+      if kind == "forward" and seed in in_zoo
+      for path in held(file)
+    }
+  return zoo.remove({path for _, file, _ in own for path in held(file)} - still_read, zoo_folder)

@@ -283,8 +283,8 @@ def add(
       continue
     # The zoo's training state of this file is replaced: by the finished file, or by the state
     # the data home holds now.
-    prefix = pathlib.PurePosixPath(relative).with_suffix(PARTIAL_SUFFIX).as_posix() + "/"
-    entries = {path: entry for path, entry in entries.items() if not path.startswith(prefix)}
+    state = held_for(relative, entries) - {relative}
+    entries = {path: entry for path, entry in entries.items() if path not in state}
     for source, source_kind, config in sources:
       path = source.relative_to(home).as_posix()
       records = tuple(
@@ -325,6 +325,32 @@ def add(
     _remove_empty_parents(zoo / stale, zoo)
   write_manifest(zoo, updated)
   return [entry for _, entry in planned.values()], skipped
+
+
+def held_for(relative: str, entries: dict[str, Entry]) -> set[str]:
+  """The paths of ``entries`` that a cache file (its data-home path ``relative``) stands for: the
+  file itself and the saved state of its unfinished training (``KEY.partial/...``)."""
+  prefix = pathlib.PurePosixPath(relative).with_suffix(PARTIAL_SUFFIX).as_posix() + "/"
+  return {path for path in entries if path == relative or path.startswith(prefix)}
+
+
+def remove(paths: set[str], zoo: pathlib.Path) -> list[Entry]:
+  """Removes the entries at ``paths`` (relative to ``zoo``) and their files; returns the entries
+  removed. The manifest is written first, so that an interruption leaves at most files it does
+  not list (``check_files`` names them), never a listed file that is gone.
+
+  Raises:
+    ValueError: the zoo holds none of ``paths`` (one line; nothing is changed).
+  """
+  before = read_manifest(zoo)
+  removed = [before[path] for path in sorted(paths) if path in before]
+  if not removed:
+    raise ValueError(f"the zoo {zoo} holds none of these files")
+  write_manifest(zoo, {path: entry for path, entry in before.items() if path not in paths})
+  for entry in removed:
+    (zoo / entry.path).unlink(missing_ok=True)
+    _remove_empty_parents(zoo / entry.path, zoo)
+  return removed
 
 
 def _remove_empty_parents(path: pathlib.Path, root: pathlib.Path) -> None:

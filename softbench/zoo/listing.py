@@ -1,5 +1,5 @@
-"""What ``softbench zoo list`` and ``zoo add`` print: the zoo's files as a table, what was added,
-and how much of its budget the zoo holds."""
+"""What ``softbench zoo list``, ``zoo add`` and ``zoo remove`` print: the zoo's files as a table,
+what was added or removed, and how much of its budget the zoo holds."""
 
 import pathlib
 
@@ -55,5 +55,12 @@ def additions(
     f"links it, softbench zoo verify checks it"
     for name in unchecked
   ]
+  lines.append(f"zoo: {usage(folder, zoo.read_manifest(folder))}")
+  return "\n".join(lines)
+
+
+def removals(removed: list[zoo.Entry], folder: pathlib.Path) -> str:
+  """What ``zoo.remove`` removed, then how much the zoo ``folder`` holds now; one fact a line."""
+  lines = [f"removed {entry.path} ({entry.kind}, {entry.bytes / KIB:.1f} KiB)" for entry in removed]
   lines.append(f"zoo: {usage(folder, zoo.read_manifest(folder))}")
   return "\n".join(lines)
