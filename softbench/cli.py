@@ -280,14 +280,22 @@ def _sweep(args: argparse.Namespace) -> None:
 def _leaderboard(args: argparse.Namespace) -> None:
   from softbench import leaderboard
   from softbench.leaderboard import doc_tables
+  from softbench.leaderboard import filters
   from softbench.leaderboard import grid
 
   if args.grid is not None:
     print(" ".join(grid.lists()[args.grid]))
     return
   results = pathlib.Path(args.results)
-  board = leaderboard.build(results)
-  print(leaderboard.text.report(board, results))
+  record_filter = filters.RecordFilter(
+    *(tuple(names or ()) for names in (args.robots, args.tasks, args.agents, args.profiles))
+  )
+  if args.write and record_filter.active:
+    raise ValueError(
+      "--write writes the whole leaderboard; drop --robots, --tasks, --agents and --profiles"
+    )
+  board = leaderboard.build(results, record_filter)
+  print(leaderboard.text.report(board, results, record_filter.describe()))
   if args.write:
     for path in [
       *leaderboard.write(board, results, pathlib.Path(args.out)),
@@ -597,6 +605,18 @@ def _leaderboard_arguments(parser: argparse.ArgumentParser) -> None:
     choices=tuple(grid.lists()),
     help="print the names on one axis of the grid make leaderboard fills, and nothing else",
   )
+  for axis, example in (
+    ("robots", "tendon-3"),
+    ("tasks", "reach"),
+    ("agents", "smpl lstm"),
+    ("profiles", "paper"),
+  ):
+    parser.add_argument(
+      f"--{axis}",
+      nargs="+",
+      metavar=axis[:-1].upper(),
+      help=f"print only the records of these {axis}, e.g. {example}",
+    )
 
 
 def _render_arguments(parser: argparse.ArgumentParser) -> None:

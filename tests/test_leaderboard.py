@@ -24,6 +24,7 @@ from softbench import records
 from softbench import run
 from softbench.leaderboard import aggregate
 from softbench.leaderboard import csv_table
+from softbench.leaderboard import filters
 from softbench.leaderboard import log_chart
 from softbench.leaderboard import overview
 from softbench.leaderboard import ranking
@@ -295,6 +296,62 @@ def test_ranking(results):
   assert circle.entries[1].estimates["position_mm"].interval is None  # One seed.
   assert circle.metrics == records.METRICS
   assert board.groups[2].metrics == ("position_mm", "normalised_tip_percent")
+
+
+# What each option of softbench leaderboard selects by, and how many of ``results``' 7 it keeps.
+FIELDS = {"robots": "robot", "tasks": "task", "agents": "agent", "profiles": "profile"}
+
+
+@pytest.mark.parametrize(
+  "asked,count",
+  [
+    ({"agents": ("zero",)}, 4),
+    ({"tasks": ("reach",)}, 1),
+    ({"robots": ("tendon-1",), "profiles": ("tiny",)}, 7),
+    ({"robots": ("tendon-2",)}, 0),
+  ],
+)
+def test_a_filtered_leaderboard_holds_exactly_the_records_asked_for(asked, count, results, capsys):
+  chosen = filters.RecordFilter(**asked)
+  board = leaderboard.build(results, chosen)
+  shown = [entry for group in board.groups for entry in (*group.entries, *group.superseded)]
+  assert board.record_count == len(shown) == count
+  for entry in shown:
+    assert all(entry.record[FIELDS[axis]] in names for axis, names in asked.items())
+  argv = [part for axis, names in asked.items() for part in (f"--{axis}", *names)]
+  assert cli.main(["leaderboard", "--results", str(results), *argv]) == 0
+  first = capsys.readouterr().out.splitlines()[0]
+  assert f"of {chosen.describe()} in {results}" in first and (count == 0) == first.startswith("no ")
+
+
+def test_an_exp1s_record_is_shown_when_all_its_arms_are_asked_for_and_no_task():
+  (path, record), *_ = [
+    loaded
+    for loaded in records.read_folder(leaderboard.DEFAULT_RESULTS)
+    if loaded[1]["format"] != records.FORMAT
+  ]
+  arms = tuple(record["robots"])
+  assert filters.RecordFilter(robots=arms, agents=("smpl",)).keeps(record), path
+  assert not filters.RecordFilter(robots=arms[1:]).keeps(record)
+  assert not filters.RecordFilter(tasks=("spiral",)).keeps(record)
+  assert not filters.RecordFilter(agents=("lstm",)).keeps(record)
+
+
+@pytest.mark.parametrize(
+  "argv,message",
+  [
+    (["--robots", "tendon-0"], "1 to 10 modules"),
+    (["--tasks", "juggle"], "unknown task"),
+    (["--agents", "oracle"], "unknown agent"),
+    (["--profiles", "huge"], "unknown profile"),
+    (["--robots", "tendon-1", "--write"], "--write writes the whole leaderboard"),
+  ],
+)
+def test_the_cli_refuses_bad_filters_in_one_line(argv, message, results, tmp_path, capsys):
+  argv = ["leaderboard", "--results", str(results), "--out", str(tmp_path / "site"), *argv]
+  assert cli.main(argv) == cli.EXIT_USAGE
+  error = capsys.readouterr().err
+  assert message in error and error.count("\n") == 1 and not (tmp_path / "site").exists()
 
 
 def test_an_agent_that_learns_by_acting_shows_its_steps_and_ranks_with_the_others(

@@ -5,6 +5,7 @@ over seeds), ``overview`` (every agent on every task of a robot, beside the pape
 values), ``aggregate`` (each agent across tasks: IQM, stratified bootstrap interval, performance
 profiles), ``exp1s_board`` (Exp1S records in the paper's layout, beside the paper's values),
 ``figure_table`` (the tables every page renders alike), ``text`` (the printout),
+``filters`` (the records of some robots, tasks, agents or profiles, for a partial printout),
 ``markdown_page`` and ``html_page`` (``README.md`` and ``index.html``, the latter from the Jinja2
 template in ``templates/``, with ``log_chart``'s log-axis bar charts), ``csv_table``
 (``leaderboard.csv``: every shown row), ``doc_tables`` (the results tables of the repository's
@@ -17,6 +18,7 @@ from softbench import records
 from softbench import storage
 from softbench.leaderboard import aggregate
 from softbench.leaderboard import csv_table
+from softbench.leaderboard import filters
 from softbench.leaderboard import html_page
 from softbench.leaderboard import markdown_page
 from softbench.leaderboard import ranking
@@ -26,13 +28,19 @@ DEFAULT_RESULTS = records.DEFAULT_FOLDER
 DEFAULT_OUT = pathlib.Path("leaderboard")
 
 
-def build(results: pathlib.Path = DEFAULT_RESULTS) -> ranking.Leaderboard:
-  """The leaderboard of every record in ``results`` (empty if the folder does not exist).
+def build(
+  results: pathlib.Path = DEFAULT_RESULTS, record_filter: filters.RecordFilter | None = None
+) -> ranking.Leaderboard:
+  """The leaderboard of every record in ``results`` (empty if the folder does not exist), or of
+  those ``record_filter`` keeps (every record is checked all the same).
 
   Raises:
     records.RecordError: a record is malformed or was edited (one line naming the file).
   """
-  return ranking.rank(records.read_folder(results))
+  loaded = records.read_folder(results)
+  if record_filter is not None:
+    loaded = [(path, record) for path, record in loaded if record_filter.keeps(record)]
+  return ranking.rank(loaded)
 
 
 def write(

@@ -23,8 +23,11 @@ def _aligned(rows: list[list[str]], right: set[int]) -> list[str]:
   ]
 
 
-def summary(board: ranking.Leaderboard, results: pathlib.Path) -> str:
-  """The first line: how many records, from where, and how to read the figures."""
+def summary(board: ranking.Leaderboard, results: pathlib.Path, asked_for: str = "") -> str:
+  """The first line: how many records (of those ``asked_for``, if only some), from where, and
+  how to read the figures."""
+  if not board.record_count and asked_for:
+    return f"no result records of {asked_for} in {results}"
   if not board.record_count:
     where = "no folder" if not pathlib.Path(results).exists() else "an empty folder"
     option = "" if pathlib.Path(results) == records.DEFAULT_FOLDER else f" --results {results}"
@@ -32,7 +35,8 @@ def summary(board: ranking.Leaderboard, results: pathlib.Path) -> str:
       f"no result records in {results} ({where}); make one with softbench run, e.g. "
       f"softbench run --task spiral --agent smpl{option}"
     )
-  parts = [f"{board.record_count} result record(s) in {results}, newest {board.latest_date}"]
+  of = f" of {asked_for}" if asked_for else ""
+  parts = [f"{board.record_count} result record(s){of} in {results}, newest {board.latest_date}"]
   if board.groups:
     parts.append(
       f"one row per agent, profile and eval mode (its newest record), ranked by "
@@ -95,11 +99,11 @@ def overview_section(views: tuple[overview.Overview, ...]) -> list[str]:
   ]
 
 
-def report(board: ranking.Leaderboard, results: pathlib.Path) -> str:
-  """The whole printout."""
+def report(board: ranking.Leaderboard, results: pathlib.Path, asked_for: str = "") -> str:
+  """The whole printout (of the records ``asked_for``, if only some)."""
   return "\n\n".join(
     [
-      summary(board, results),
+      summary(board, results, asked_for),
       *overview_section(overview.overviews(board)),
       *(table(group) for group in board.groups),
       *(exp1s_section(group) for group in board.exp1s),
