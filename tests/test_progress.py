@@ -10,6 +10,7 @@ import re
 from rich import progress as rich_progress
 
 from softbench import progress
+from softbench.sweep import display
 
 
 def _state_lines(output: str) -> list[str]:
@@ -99,3 +100,27 @@ def test_in_a_seed_worker_a_hidden_bar_sends_its_state_at_most_every_interval(mo
   monkeypatch.setattr(progress, "_relay", None)  # Not a worker: nothing to show it, no bar.
   with progress.epochs("forward tendon-1", 800, show=False) as on_epoch_end:
     assert on_epoch_end is None
+
+
+def test_a_sweeps_time_left_comes_from_its_pace_when_its_tasks_end_minutes_apart(
+  capsys, monkeypatch
+):
+  monkeypatch.setattr(progress, "LOG_INTERVAL_S", 0.0)  # Every change is a line.
+  now, counting = [0.0], progress.counting
+  monkeypatch.setattr(
+    progress,
+    "counting",
+    lambda *args, **options: counting(*args, **options, get_time=lambda: now[0]),
+  )
+  with display.Display(tasks=10, settings=2, show=True) as shown:
+    for done, minutes in ((1, 10), (2, 25), (3, 40)):  # Tasks 15 minutes apart.
+      now[0] = 60.0 * minutes
+      shown.update(done, 2, 0, 0)
+  lines = _state_lines(capsys.readouterr().out)
+  assert "-:--:-- left" in lines[0]  # One task ended: no pace yet.
+  # Then 2 tasks in 30 minutes: the 7 left take 1:45:00 (rich's default looked 30 s back only).
+  assert re.fullmatch(
+    r"sweep: tasks: 3/10, 2 running, 0 failed, 0/2 records, 1:45:00 left, "
+    r"0:40:00 elapsed",
+    lines[2],
+  ), lines
