@@ -3,13 +3,16 @@ the work ends: each bar writes a line of its state at most every ``progress.LOG_
 seed worker, hidden bars send their states to the parent."""
 
 import collections
+import functools
 import os
 import queue
 import re
 
+import pytest
 from rich import progress as rich_progress
 
 from softbench import progress
+from softbench.data import progress as sample_progress
 from softbench.sweep import display
 
 
@@ -124,3 +127,18 @@ def test_a_sweeps_time_left_comes_from_its_pace_when_its_tasks_end_minutes_apart
     r"0:40:00 elapsed",
     lines[2],
   ), lines
+
+
+def test_a_sample_bar_updated_a_minute_apart_shows_its_rate_and_time_left(monkeypatch):
+  # A SAC training's bar: one update per 1,000-step chunk.
+  now = [0.0]
+  monkeypatch.setattr(
+    rich_progress, "Progress", functools.partial(rich_progress.Progress, get_time=lambda: now[0])
+  )
+  with sample_progress.SampleProgress("sac", total=30_000, enabled=False) as bar:
+    for chunk in range(1, 4):
+      now[0] = 60.0 * chunk
+      bar.update(1_000 * chunk)
+    (task,) = bar._progress.tasks  # pylint: disable=protected-access
+    assert task.speed == pytest.approx(1_000 / 60.0)  # Samples per second, over 2 minutes.
+    assert task.time_remaining == pytest.approx(27 * 60.0)
