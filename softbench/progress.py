@@ -16,7 +16,9 @@ from rich import progress as rich_progress
 
 LOG_INTERVAL_S = 60.0  # (s) Least time between two lines of one bar written to a log.
 RELAY_INTERVAL_S = 0.5  # (s) Least time between two states of one bar sent to the parent.
-PACE_WINDOW_S = 30.0  # (s) The time left is estimated from the pace of this much time (rich's).
+# (s) How far back a bar's rate and time left look (rich's default: 30 s). A sweep's tasks and a
+# SAC training's 1,000-step chunks end minutes apart: over 30 s there was no estimate at all.
+PACE_WINDOW_S = 7 * 24 * 3600.0
 
 _relay = None  # Where this process's bars send their states (a seed worker's queue), or None.
 
@@ -149,13 +151,12 @@ def counting(
   show: bool = True,
   transient: bool = False,
   extra: tuple[rich_progress.ProgressColumn, ...] = (),
-  pace_window_s: float = PACE_WINDOW_S,
   **options,
 ) -> rich_progress.Progress:
   """A progress display whose bars read ``description [bar] done/total [extra] elapsed``;
   nothing at all unless ``show``; gone once finished if ``transient``; on an output that is not
   a terminal, a line per bar (with the extra columns' text) at most every ``LOG_INTERVAL_S``. A
-  time-left column estimates from each bar's pace over its last ``pace_window_s``. ``options``:
+  time-left column estimates from each bar's pace over its last ``PACE_WINDOW_S``. ``options``:
   rich's other ``Progress`` options (a test's own clock, ``get_time``)."""
   return _Progress(
     rich_progress.TextColumn("{task.description}"),
@@ -166,6 +167,6 @@ def counting(
     logged=extra,
     disable=not show,
     transient=transient,
-    speed_estimate_period=pace_window_s,
+    speed_estimate_period=PACE_WINDOW_S,
     **options,
   )

@@ -4,14 +4,12 @@ from rich import console as rich_console
 from rich import progress as rich_progress
 from rich import text
 
-# (s) How far back the rate and the time left look: a SAC training updates its bar once per
-# 1,000-step chunk, about a minute apart at the default profile (30,000 steps of a tendon-3 seed
-# took about half an hour), and over rich's default 30 s it showed no rate and no time left.
-PACE_WINDOW_S = 3600.0
+from softbench import progress
 
 
 class _RateColumn(rich_progress.ProgressColumn):
-  """Samples per second, averaged over the last ``PACE_WINDOW_S``."""
+  """Samples per second, averaged over the last ``progress.PACE_WINDOW_S`` (or rich's last 1,000
+  updates)."""
 
   def render(self, task: rich_progress.Task) -> text.Text:
     speed = task.finished_speed or task.speed
@@ -36,7 +34,7 @@ class SampleProgress:
       rich_progress.TimeRemainingColumn(),
       console=rich_console.Console(stderr=True),
       disable=not enabled,
-      speed_estimate_period=PACE_WINDOW_S,
+      speed_estimate_period=progress.PACE_WINDOW_S,
     )
     self._task = self._progress.add_task(description, total=total, completed=completed)
 

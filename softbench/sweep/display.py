@@ -9,10 +9,6 @@ from rich import progress as rich_progress
 
 from softbench import progress as progress_bars
 
-# (s) How far back the pace behind the time left reaches: a whole paper-profile sweep (tasks end
-# minutes to hours apart; over rich's default 30 s there was no estimate at all, `-:--:-- left`).
-PACE_WINDOW_S = 7 * 24 * 3600.0
-
 
 class Display:
   """A context manager showing one bar over a sweep's Ray tasks (``update`` moves it) and the
@@ -20,7 +16,7 @@ class Display:
 
   Running counts the tasks whose inputs are ready, up to the cluster's cores (Ray runs those);
   the time left is estimated from the pace of the tasks so far (since the first one ended, up to
-  ``PACE_WINDOW_S``), which mixes short evaluations with long trainings; a worker's bar
+  ``progress.PACE_WINDOW_S``), which mixes short evaluations with long trainings; a worker's bar
   estimates its own work's the same way."""
 
   def __init__(self, tasks: int, settings: int, show: bool):
@@ -31,7 +27,6 @@ class Display:
         rich_progress.TimeRemainingColumn(),
         rich_progress.TextColumn("left,"),
       ),
-      pace_window_s=PACE_WINDOW_S,
     )
     self._settings = settings
     self._bar = self._progress.add_task("sweep: tasks", total=tasks, counts=self._counts(0, 0, 0))
