@@ -122,6 +122,9 @@ class EpochReport:
   best_validation_loss: float
   improved: bool
   seconds: float
+  resumed: bool = False
+  """Run before the training was stopped and resumed: `fit` hands it on again when it resumes
+  (a progress bar starts there; its pace is that of the epochs run since)."""
 
 
 @dataclass
@@ -233,8 +236,8 @@ def fit(
   the same weights. `batch_loss` must use tensors on the model's device: `fit` moves `model` and
   the windows there, nothing else, and hands `model` back on the CPU (`on_device`). Inside
   `smpl.snapshots.resumable`, a stopped fit resumes where it was (`on_epoch_end` then first gets
-  the epochs already run). A model whose `compiles_on_cpu` is False trains eagerly on the CPU
-  whatever `config.compile` says.
+  the epochs already run, marked `resumed`). A model whose `compiles_on_cpu` is False trains
+  eagerly on the CPU whatever `config.compile` says.
   """
   device = device if device is not None else default_device()
   parameters = [parameter for parameter in model.parameters() if parameter.requires_grad]
@@ -266,7 +269,7 @@ def fit(
     if saved is not None:
       run.restore(saved)
       for report in run.history if on_epoch_end is not None else ():
-        on_epoch_end(report)
+        on_epoch_end(dataclasses.replace(report, resumed=True))
     finished_before = run.finished
     last_saved = time.monotonic()
     while not run.finished and len(run.history) < config.max_epochs:

@@ -117,7 +117,8 @@ class _Progress(rich_progress.Progress):
 
 class _RelayedEpochs:
   """An epoch callback of ``smpl.training`` (a context manager) whose bar is not drawn but relayed
-  (``relay_to``): the epochs done, complete when training ends (early stopping included)."""
+  (``relay_to``): the epochs done, complete when training ends (early stopping included); the
+  pace (time left) of a resumed training is that of the epochs run since it resumed."""
 
   def __init__(self, label: str, max_epochs: int) -> None:
     self._progress = counting(show=False)
@@ -131,7 +132,10 @@ class _RelayedEpochs:
     self._progress.update(self._task, total=task.completed or 1, completed=task.completed or 1)
 
   def __call__(self, report) -> None:
-    self._progress.update(self._task, completed=report.epoch + 1)
+    if report.resumed:  # Where a resumed training starts: no pace, nothing relayed yet.
+      self._progress.reset(self._task, completed=report.epoch + 1)
+    else:
+      self._progress.update(self._task, completed=report.epoch + 1)
 
 
 def epochs(label: str | None, max_epochs: int, show: bool):

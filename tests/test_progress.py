@@ -2,7 +2,6 @@
 the work ends: each bar writes a line of its state at most every ``progress.LOG_INTERVAL_S``; in a
 seed worker, hidden bars send their states to the parent."""
 
-import collections
 import functools
 import os
 import queue
@@ -11,6 +10,7 @@ import re
 import pytest
 from rich import progress as rich_progress
 
+from smpl import training
 from softbench import progress
 from softbench.data import progress as sample_progress
 from softbench.sweep import display
@@ -95,7 +95,7 @@ def test_in_a_seed_worker_a_hidden_bar_sends_its_state_at_most_every_interval(mo
     for _ in range(3):
       bars.advance(bar)
   assert _relayed(states) == [("episode", 1, 3), ("episode", 3, 3)]  # The first, then complete.
-  report = collections.namedtuple("Report", "epoch")
+  report = functools.partial(_report, resumed=False)
   with progress.epochs("forward tendon-1", 800, show=False) as on_epoch_end:
     for epoch in range(5):  # Early stopping after 5 of 800 epochs.
       on_epoch_end(report(epoch))
@@ -103,6 +103,42 @@ def test_in_a_seed_worker_a_hidden_bar_sends_its_state_at_most_every_interval(mo
   monkeypatch.setattr(progress, "_relay", None)  # Not a worker: nothing to show it, no bar.
   with progress.epochs("forward tendon-1", 800, show=False) as on_epoch_end:
     assert on_epoch_end is None
+
+
+def _report(epoch: int, resumed: bool) -> training.EpochReport:
+  return training.EpochReport(epoch, 1.0, 1.0, 1.0, False, 8.0, resumed)
+
+
+def test_a_resumed_trainings_relayed_bar_takes_its_pace_from_the_epochs_run_since(
+  capsys, monkeypatch
+):
+  # A forward model resumed at epoch 403 of 800: fit hands on the 403 epochs run before, at
+  # once, then runs one every 8 s. Its bar in the sweep's display must not count the 403 as pace.
+  states = queue.SimpleQueue()
+  monkeypatch.setattr(progress, "_relay", states)
+  monkeypatch.setattr(progress, "RELAY_INTERVAL_S", 0.0)  # Every state is sent.
+  monkeypatch.setattr(progress, "LOG_INTERVAL_S", 0.0)  # Every change is a line.
+  now, counting = [0.0], progress.counting
+  monkeypatch.setattr(
+    progress,
+    "counting",
+    lambda *args, **options: counting(*args, **options, get_time=lambda: now[0]),
+  )
+  sent = []  # (time, state) as the worker sends them.
+  with progress.epochs("forward tendon-3", 800, show=False) as on_epoch_end:
+    for epoch in range(406):
+      now[0] = 8.0 * max(0, epoch - 402)
+      on_epoch_end(_report(epoch, resumed=epoch < 403))
+      sent += [(now[0], states.get()) for _ in range(states.qsize())]
+  progress.relay_to(None)  # The sweep's own process, which shows them.
+  with display.Display(tasks=1, settings=1, show=True) as shown:
+    for now[0], state in sent:
+      shown.show_workers([state])
+  lines = [line for line in _state_lines(capsys.readouterr().out) if "forward" in line]
+  # From 404 at 8 s to 406 at 24 s: an epoch in 8 s, so the 394 left take 0:52:32.
+  assert re.fullmatch(
+    r"forward tendon-3: 406/800, 0:52:32 left, \d+:\d\d:\d\d elapsed", lines[-1]
+  ), lines
 
 
 def test_a_sweeps_time_left_comes_from_its_pace_when_its_tasks_end_minutes_apart(
