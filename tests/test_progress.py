@@ -105,6 +105,17 @@ def test_in_a_seed_worker_a_hidden_bar_sends_its_state_at_most_every_interval(mo
     assert on_epoch_end is None
 
 
+def _clocked(monkeypatch) -> list[float]:
+  """Every display of ``progress.counting`` from now on reads the time from the list returned."""
+  now, counting = [0.0], progress.counting
+  monkeypatch.setattr(
+    progress,
+    "counting",
+    lambda *args, **options: counting(*args, **options, get_time=lambda: now[0]),
+  )
+  return now
+
+
 def _report(epoch: int, resumed: bool) -> training.EpochReport:
   return training.EpochReport(epoch, 1.0, 1.0, 1.0, False, 8.0, resumed)
 
@@ -118,12 +129,7 @@ def test_a_resumed_trainings_relayed_bar_takes_its_pace_from_the_epochs_run_sinc
   monkeypatch.setattr(progress, "_relay", states)
   monkeypatch.setattr(progress, "RELAY_INTERVAL_S", 0.0)  # Every state is sent.
   monkeypatch.setattr(progress, "LOG_INTERVAL_S", 0.0)  # Every change is a line.
-  now, counting = [0.0], progress.counting
-  monkeypatch.setattr(
-    progress,
-    "counting",
-    lambda *args, **options: counting(*args, **options, get_time=lambda: now[0]),
-  )
+  now = _clocked(monkeypatch)
   sent = []  # (time, state) as the worker sends them.
   with progress.epochs("forward tendon-3", 800, show=False) as on_epoch_end:
     for epoch in range(406):
@@ -145,12 +151,7 @@ def test_a_sweeps_time_left_comes_from_its_pace_when_its_tasks_end_minutes_apart
   capsys, monkeypatch
 ):
   monkeypatch.setattr(progress, "LOG_INTERVAL_S", 0.0)  # Every change is a line.
-  now, counting = [0.0], progress.counting
-  monkeypatch.setattr(
-    progress,
-    "counting",
-    lambda *args, **options: counting(*args, **options, get_time=lambda: now[0]),
-  )
+  now = _clocked(monkeypatch)
   with display.Display(tasks=10, settings=2, show=True) as shown:
     for done, minutes in ((1, 10), (2, 25), (3, 40)):  # Tasks 15 minutes apart.
       now[0] = 60.0 * minutes
@@ -167,10 +168,7 @@ def test_a_sweeps_time_left_comes_from_its_pace_when_its_tasks_end_minutes_apart
 
 def test_a_sample_bar_updated_a_minute_apart_shows_its_rate_and_time_left(monkeypatch):
   # A SAC training's bar: one update per 1,000-step chunk.
-  now = [0.0]
-  monkeypatch.setattr(
-    rich_progress, "Progress", functools.partial(rich_progress.Progress, get_time=lambda: now[0])
-  )
+  now = _clocked(monkeypatch)
   with sample_progress.SampleProgress("sac", total=30_000, enabled=False) as bar:
     for chunk in range(1, 4):
       now[0] = 60.0 * chunk
@@ -178,3 +176,29 @@ def test_a_sample_bar_updated_a_minute_apart_shows_its_rate_and_time_left(monkey
     (task,) = bar._progress.tasks  # pylint: disable=protected-access
     assert task.speed == pytest.approx(1_000 / 60.0)  # Samples per second, over 2 minutes.
     assert task.time_remaining == pytest.approx(27 * 60.0)
+
+
+def test_a_hidden_sample_bar_in_a_worker_is_relayed_from_where_it_resumed(capsys, monkeypatch):
+  # A SAC training resumed at step 12,000 of 30,000 in a seed worker: its bar is not drawn there,
+  # but sent to the parent, whose display shows its pace since the resume and what is left.
+  states = queue.SimpleQueue()
+  monkeypatch.setattr(progress, "_relay", states)
+  monkeypatch.setattr(progress, "RELAY_INTERVAL_S", 0.0)
+  monkeypatch.setattr(progress, "LOG_INTERVAL_S", 0.0)
+  now, sent = _clocked(monkeypatch), []
+  with sample_progress.SampleProgress("sac tendon-3 seed 1", 30_000, 12_000, False) as bar:
+    for chunk in range(1, 4):
+      now[0] = 60.0 * chunk
+      bar.update(12_000 + 1_000 * chunk)
+      sent += [(now[0], states.get()) for _ in range(states.qsize())]
+  assert capsys.readouterr() == ("", "")  # Nothing drawn in the worker.
+  assert [state[1:] for _, state in sent] == [
+    ("sac tendon-3 seed 1", 13_000 + 1_000 * chunk, 30_000) for chunk in range(3)
+  ]
+  progress.relay_to(None)
+  with display.Display(tasks=1, settings=1, show=True) as shown:
+    for now[0], state in sent:
+      shown.show_workers([state])
+  (*_, line) = [line for line in _state_lines(capsys.readouterr().out) if "sac" in line]
+  # 2,000 steps in 2 minutes since the first state: the 15,000 left take 15 minutes.
+  assert re.fullmatch(r"sac tendon-3 seed 1: 15000/30000, 0:15:00 left, 0:02:00 elapsed", line)

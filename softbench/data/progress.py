@@ -1,4 +1,6 @@
-"""A rich progress bar of samples collected: done / total, samples per second, time left."""
+"""A progress bar of samples collected (a babbling collection's, a SAC training's environment
+steps): done / total, samples per second, time left, time spent; relayed to the parent where it is
+hidden in a seed or sweep worker, like every bar of ``softbench.progress``."""
 
 from rich import console as rich_console
 from rich import progress as rich_progress
@@ -13,28 +15,27 @@ class _RateColumn(rich_progress.ProgressColumn):
 
   def render(self, task: rich_progress.Task) -> text.Text:
     speed = task.finished_speed or task.speed
-    return text.Text("? samples/s" if speed is None else f"{speed:.1f} samples/s")
+    return text.Text("? samples/s," if speed is None else f"{speed:.1f} samples/s,")
 
 
 class SampleProgress:
-  """A progress bar on stderr, or nothing at all when ``enabled`` is False.
+  """A progress bar on stderr; where ``enabled`` is False, none, but its states still go to the
+  parent from a seed or sweep worker (``progress.relay_to``). ``completed``: where a resumed
+  collection or training starts (not counted in its pace).
 
   with SampleProgress("tendon-3", total=14000) as bar:
     bar.update(completed)
   """
 
   def __init__(self, description: str, total: int, completed: int = 0, enabled: bool = True):
-    self._progress = rich_progress.Progress(
-      rich_progress.TextColumn("{task.description}"),
-      rich_progress.BarColumn(),
-      rich_progress.MofNCompleteColumn(),
-      _RateColumn(),
-      rich_progress.TimeElapsedColumn(),
-      rich_progress.TextColumn("ETA"),
-      rich_progress.TimeRemainingColumn(),
+    self._progress = progress.counting(
+      enabled,
+      extra=(
+        _RateColumn(),
+        rich_progress.TimeRemainingColumn(),
+        rich_progress.TextColumn("left,"),
+      ),
       console=rich_console.Console(stderr=True),
-      disable=not enabled,
-      speed_estimate_period=progress.PACE_WINDOW_S,
     )
     self._task = self._progress.add_task(description, total=total, completed=completed)
 
