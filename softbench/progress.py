@@ -115,40 +115,50 @@ class _Progress(rich_progress.Progress):
     self.console.print(line, soft_wrap=True)  # One line, however long.
 
 
-class _RelayedEpochs:
-  """An epoch callback of ``smpl.training`` (a context manager) whose bar is not drawn but relayed
-  (``relay_to``): the epochs done, complete when training ends (early stopping included); the
-  pace (time left) of a resumed training is that of the epochs run since it resumed."""
+class _Epochs:
+  """An epoch callback of ``smpl.training`` (a context manager): a bar of the epochs done of the
+  budget, the latest losses and the time left (at most: early stopping may end the training
+  sooner; a resumed training's pace is that of the epochs run since), complete when the training
+  ends; drawn if ``show``, else only relayed (``relay_to``)."""
 
-  def __init__(self, label: str, max_epochs: int) -> None:
-    self._progress = counting(show=False)
-    self._task = self._progress.add_task(label, total=max_epochs)
+  def __init__(self, label: str, max_epochs: int, show: bool) -> None:
+    self._progress = counting(
+      show,
+      extra=(
+        rich_progress.TextColumn("{task.fields[losses]}"),
+        rich_progress.TimeRemainingColumn(),
+        rich_progress.TextColumn("left,"),
+      ),
+    )
+    self._task = self._progress.add_task(label, total=max_epochs, losses="")
 
-  def __enter__(self) -> "_RelayedEpochs":
+  def __enter__(self) -> "_Epochs":
+    self._progress.start()
     return self
 
   def __exit__(self, *exception) -> None:
     (task,) = self._progress.tasks
     self._progress.update(self._task, total=task.completed or 1, completed=task.completed or 1)
+    self._progress.stop()
 
   def __call__(self, report) -> None:
+    losses = (
+      f"train {report.train_loss:.2e}, validation {report.validation_loss:.2e}, "
+      f"best {report.best_validation_loss:.2e},"
+    )
     if report.resumed:  # Where a resumed training starts: no pace, nothing relayed yet.
-      self._progress.reset(self._task, completed=report.epoch + 1)
+      self._progress.reset(self._task, completed=report.epoch + 1, losses=losses)
     else:
-      self._progress.update(self._task, completed=report.epoch + 1)
+      self._progress.update(self._task, completed=report.epoch + 1, losses=losses)
 
 
 def epochs(label: str | None, max_epochs: int, show: bool):
   """The epoch progress bar of a training named ``label`` (a context manager giving the callback
-  ``smpl.training`` takes, or None): drawn if ``show`` (``smpl.progress.EpochProgressBar``), else
-  relayed in a seed worker (``relay_to``); none if ``label`` is None or nothing would show it."""
+  ``smpl.training`` takes, or None): drawn if ``show``, else relayed in a seed or sweep worker
+  (``relay_to``); none if ``label`` is None or nothing would show it."""
   if label is None or not (show or _relay is not None):
     return contextlib.nullcontext(None)
-  if not show:
-    return _RelayedEpochs(label, max_epochs)
-  from smpl import progress as epoch_progress  # Here: it imports torch, which listings need not.
-
-  return epoch_progress.EpochProgressBar(label, max_epochs)
+  return _Epochs(label, max_epochs, show)
 
 
 def counting(

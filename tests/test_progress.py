@@ -147,6 +147,23 @@ def test_a_resumed_trainings_relayed_bar_takes_its_pace_from_the_epochs_run_sinc
   ), lines
 
 
+def test_a_drawn_epoch_bar_shows_the_losses_and_the_time_left_from_the_epochs_run_since(
+  capsys, monkeypatch
+):
+  # softbench run's own process: the same training as above, drawn (here, in a log).
+  monkeypatch.setattr(progress, "LOG_INTERVAL_S", 0.0)
+  now = _clocked(monkeypatch)
+  with progress.epochs("forward tendon-3", 800, show=True) as on_epoch_end:
+    for epoch in range(406):
+      now[0] = 8.0 * max(0, epoch - 402)
+      on_epoch_end(_report(epoch, resumed=epoch < 403))
+  lines = _state_lines(capsys.readouterr().out)
+  last, end = [line for line in lines if "/800" in line][-1], lines[-1]
+  losses = "train 1.00e+00, validation 1.00e+00, best 1.00e+00"
+  assert last == f"forward tendon-3: 406/800, {losses}, 0:52:32 left, 0:00:24 elapsed"
+  assert end == f"forward tendon-3: 406/406, {losses}, 0:00:00 left, 0:00:24 elapsed"
+
+
 def test_a_sweeps_time_left_comes_from_its_pace_when_its_tasks_end_minutes_apart(
   capsys, monkeypatch
 ):
