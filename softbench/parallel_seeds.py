@@ -43,7 +43,7 @@ class WorkerDied(RuntimeError):
 def in_processes(function, arguments: list[tuple], label: str, workers: int) -> list:
   """``function(*args)`` for each entry of ``arguments`` in ``workers`` processes (one torch and
   MuJoCo thread each), with a progress bar of the entries done and one per worker of the work it
-  is on (its own bars, relayed); results in order.
+  is on (its own bars, relayed), each with the time left at its pace; results in order.
 
   A worker's exception is raised here. On Ctrl-C, or when a worker dies, the workers are
   terminated; seeds whose checkpoints were written are reused by the next run.
@@ -51,7 +51,7 @@ def in_processes(function, arguments: list[tuple], label: str, workers: int) -> 
   Raises:
     WorkerDied: a worker process ended without a result.
   """
-  progress, worker_bars = progress_bars.counting(), {}
+  progress, worker_bars = progress_bars.counting(extra=progress_bars.time_left()), {}
   context = multiprocessing.get_context("spawn")
   states = context.SimpleQueue()  # Written at once (no feeder thread): read before the results.
   executor = futures.ProcessPoolExecutor(

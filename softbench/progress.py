@@ -115,6 +115,13 @@ class _Progress(rich_progress.Progress):
     self.console.print(line, soft_wrap=True)  # One line, however long.
 
 
+def time_left() -> tuple[rich_progress.ProgressColumn, ...]:
+  """Columns for ``counting``'s ``extra``: the time left at the bar's pace over its last
+  ``PACE_WINDOW_S`` (``-:--:--`` before it has one), read ``1:52:10 left,``. New ones for each
+  display (a column caches what it drew by task id)."""
+  return rich_progress.TimeRemainingColumn(), rich_progress.TextColumn("left,")
+
+
 class _Epochs:
   """An epoch callback of ``smpl.training`` (a context manager): a bar of the epochs done of the
   budget, the latest losses and the time left (at most: early stopping may end the training
@@ -124,11 +131,7 @@ class _Epochs:
   def __init__(self, label: str, max_epochs: int, show: bool) -> None:
     self._progress = counting(
       show,
-      extra=(
-        rich_progress.TextColumn("{task.fields[losses]}"),
-        rich_progress.TimeRemainingColumn(),
-        rich_progress.TextColumn("left,"),
-      ),
+      extra=(rich_progress.TextColumn("{task.fields[losses]}"), *time_left()),
     )
     self._task = self._progress.add_task(label, total=max_epochs, losses="")
 

@@ -30,11 +30,7 @@ class SampleProgress:
   def __init__(self, description: str, total: int, completed: int = 0, enabled: bool = True):
     self._progress = progress.counting(
       enabled,
-      extra=(
-        _RateColumn(),
-        rich_progress.TimeRemainingColumn(),
-        rich_progress.TextColumn("left,"),
-      ),
+      extra=(_RateColumn(), *progress.time_left()),
       console=rich_console.Console(stderr=True),
     )
     self._task = self._progress.add_task(description, total=total, completed=completed)

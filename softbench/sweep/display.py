@@ -22,11 +22,7 @@ class Display:
   def __init__(self, tasks: int, settings: int, show: bool):
     self._progress = progress_bars.counting(
       show,
-      extra=(
-        rich_progress.TextColumn("{task.fields[counts]}"),
-        rich_progress.TimeRemainingColumn(),
-        rich_progress.TextColumn("left,"),
-      ),
+      extra=(rich_progress.TextColumn("{task.fields[counts]}"), *progress_bars.time_left()),
     )
     self._settings = settings
     self._bar = self._progress.add_task("sweep: tasks", total=tasks, counts=self._counts(0, 0, 0))
