@@ -139,9 +139,10 @@ class _Epochs:
     self._progress.start()
     return self
 
-  def __exit__(self, *exception) -> None:
-    (task,) = self._progress.tasks
-    self._progress.update(self._task, total=task.completed or 1, completed=task.completed or 1)
+  def __exit__(self, error_type, *exception) -> None:
+    if error_type is None:  # Trained (early stopping included): the bar ends complete.
+      (task,) = self._progress.tasks
+      self._progress.update(self._task, total=task.completed or 1, completed=task.completed or 1)
     self._progress.stop()
 
   def __call__(self, report) -> None:

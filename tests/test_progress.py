@@ -162,6 +162,10 @@ def test_a_drawn_epoch_bar_shows_the_losses_and_the_time_left_from_the_epochs_ru
   losses = "train 1.00e+00, validation 1.00e+00, best 1.00e+00"
   assert last == f"forward tendon-3: 406/800, {losses}, 0:52:32 left, 0:00:24 elapsed"
   assert end == f"forward tendon-3: 406/406, {losses}, 0:00:00 left, 0:00:24 elapsed"
+  with pytest.raises(KeyboardInterrupt), progress.epochs("forward tendon-3", 800, True) as bar:
+    bar(_report(0, resumed=False))
+    raise KeyboardInterrupt  # Interrupted: the bar stays where the training stopped.
+  assert _state_lines(capsys.readouterr().out)[-1].startswith("forward tendon-3: 1/800, ")
 
 
 def test_a_sweeps_time_left_comes_from_its_pace_when_its_tasks_end_minutes_apart(
