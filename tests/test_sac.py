@@ -2,6 +2,8 @@
 weights (the registry-wide agent tests cover its acting, its records and a damaged checkpoint's
 retraining)."""
 
+import tempfile
+
 import numpy as np
 import pytest
 import stable_baselines3
@@ -42,6 +44,9 @@ def _weights(trained: dict) -> dict[str, torch.Tensor]:
 def test_an_interrupted_training_resumes_to_the_same_weights(
   home, tmp_path, monkeypatch, babbled_home
 ):
+  temporary = tmp_path / "temporary"  # SB3's own logger makes an SB3-* folder here per learn().
+  temporary.mkdir()
+  monkeypatch.setattr(tempfile, "tempdir", str(temporary))
   arm = robots.make(ROBOT)
   whole = sac.train(arm, 0, TINY)
   assert whole["environment_steps"] == sac.STEPS["tiny"]
@@ -74,6 +79,7 @@ def test_an_interrupted_training_resumes_to_the_same_weights(
   assert first.keys() == second.keys()
   for name in first:
     assert torch.equal(first[name], second[name]), name
+  assert not list(temporary.glob("SB3-*"))  # Neither training nor resuming left a log folder.
 
 
 def test_training_episodes_follow_training_stretches_fixed_by_the_seed(home):

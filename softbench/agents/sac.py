@@ -20,6 +20,7 @@ import time
 
 import numpy as np
 import stable_baselines3
+from stable_baselines3.common import logger as sb3_logger
 from stable_baselines3.common import vec_env
 import torch
 
@@ -309,6 +310,8 @@ def _trained(
           "training stopped; delete the file to train from the start"
         )
       elapsed = state["wall_time_s"]
+    # SB3's own logger would make a folder in the temporary directory at every learn() call.
+    model.set_logger(sb3_logger.Logger(folder=None, output_formats=[]))
     started, saved_at = time.perf_counter() - elapsed, time.monotonic()
     with progress_bars.SampleProgress(
       f"sac {robot.name} seed {seed}", config.steps, model.num_timesteps, show_progress
