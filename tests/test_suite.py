@@ -162,6 +162,25 @@ def test_reference_shapes_differ_and_stay_in_unit_actuation():
   assert magnitude[:10].mean() < magnitude[-10:].mean()
 
 
+def test_a_recording_from_rest_is_simulated_once_per_robot_and_actions(monkeypatch):
+  arm = robots.make("tendon-1")
+  actions = np.random.default_rng(0).uniform(-1.0, 1.0, (3, arm.action_dim))
+  recorded, _ = recorder.PoseRecorder(arm).record(actions[None])
+  first = recorder.from_rest(arm, actions)
+  np.testing.assert_array_equal(first, recorded[0])
+  assert not first.flags.writeable
+
+  def simulated(*args, **kwargs):
+    raise AssertionError("simulated")
+
+  with monkeypatch.context() as patch:
+    patch.setattr(recorder.PoseRecorder, "record", simulated)
+    assert recorder.from_rest(robots.make("tendon-1"), actions.copy()) is first  # Equal inputs.
+    for other_robot, other_actions in [(arm, actions[:2]), (arm.refined(2), actions)]:
+      with pytest.raises(AssertionError, match="simulated"):
+        recorder.from_rest(other_robot, other_actions)
+
+
 def test_reference_is_cached_and_a_corrupt_cache_is_regenerated(monkeypatch, tmp_path):
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
   arm = robots.make("tendon-1")
@@ -171,8 +190,8 @@ def test_reference_is_cached_and_a_corrupt_cache_is_regenerated(monkeypatch, tmp
   def must_not_simulate(*args, **kwargs):
     raise AssertionError("a cached reference was simulated again")
 
-  with monkeypatch.context() as patch:
-    patch.setattr(recorder.PoseRecorder, "record", must_not_simulate)
+  with monkeypatch.context() as patch:  # Nor taken from the process's recordings.
+    patch.setattr(recorder, "from_rest", must_not_simulate)
     cached = references.reference(arm, "circle", length=5)
   np.testing.assert_array_equal(cached.poses, first.poses)
 

@@ -51,7 +51,6 @@ class Reach(base.SoftArmTask):
       raise ValueError(f"steps must be a positive integer, got {steps!r}")
     self.module = module
     self._num_steps = steps
-    self._recorder = recorder.PoseRecorder(robot)
     self._target = None
 
   @property
@@ -61,8 +60,8 @@ class Reach(base.SoftArmTask):
   def initialize_episode(self, physics) -> None:
     action = self.random.uniform(-1.0, 1.0, self.robot.action_dim)
     holds = int(np.ceil(TARGET_SETTLE_SECONDS / self.robot.control_timestep))
-    poses, _ = self._recorder.record(np.tile(action, (1, holds, 1)))
-    self._target = poses[0, -1, self.module - 1, :3]
+    poses = recorder.from_rest(self.robot, np.tile(action, (holds, 1)))
+    self._target = poses[-1, self.module - 1, :3].copy()
     super().initialize_episode(physics)
 
   def targets_at(self, step: int) -> np.ndarray:

@@ -224,12 +224,12 @@ def reference(robot: base.SoftArm, shape: str, length: int = REFERENCE_LENGTH) -
   if cached is not None:
     return cached
   actions = pattern_actions(robot, shape, length)
-  poses, _ = recorder.PoseRecorder(robot).record(actions[None])
-  arrays = {"actions": actions, "poses": poses[0]}
+  poses = recorder.from_rest(robot, actions).copy()
+  arrays = {"actions": actions, "poses": poses}
   storage.write_cache_file(path, storage.npz_bytes(arrays), "cached reference")
   storage.write_cache_file(
     path.with_suffix(".json"),
     json.dumps({"config": config, "sha256": storage.arrays_sha256(arrays)}, indent=2) + "\n",
     "cached reference's description",
   )
-  return Reference(shape, actions, poses[0])
+  return Reference(shape, actions, poses)
