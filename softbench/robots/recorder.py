@@ -20,7 +20,7 @@ from softbench.robots import chain
 POSE_SIZE = 6  # Tip position (m) and unit orientation vector of one module.
 STATE_SPEC = mujoco.mjtState.mjSTATE_FULLPHYSICS
 # Recordings from rest that ``from_rest`` keeps per process: a 1,000-step reference of a
-# 5-module arm holds 240 kB of poses, a reach target's 4 poses under 1 kB.
+# 5-module arm holds 240 kB of poses, a reach target's 4 to 16 poses 1 to 2.3 kB.
 FROM_REST_CACHE_SIZE = 64
 
 
