@@ -52,17 +52,14 @@ class Estimate:
   @classmethod
   def of(cls, values: list[float]) -> "Estimate":
     values = np.asarray(values, dtype=float)
-    return cls(float(np.mean(values)), float(np.std(values)), _bootstrap_interval(values))
-
-
-def _bootstrap_interval(values: np.ndarray) -> tuple[float, float] | None:
-  return _interval_of(tuple(values.tolist()))
+    interval = _bootstrap_interval(tuple(values.tolist()))
+    return cls(float(np.mean(values)), float(np.std(values)), interval)
 
 
 # Once per process for the same per-seed values (2.3 ms of a core each): a process that boards
 # the same records again (each view and aggregate the tests build) takes the interval it has.
 @functools.lru_cache(maxsize=16_384)
-def _interval_of(seed_values: tuple[float, ...]) -> tuple[float, float] | None:
+def _bootstrap_interval(seed_values: tuple[float, ...]) -> tuple[float, float] | None:
   values = np.array(seed_values)
   if values.size < MIN_SEEDS_FOR_INTERVAL:
     return None
