@@ -174,7 +174,8 @@ def test_a_sweeps_time_left_comes_from_its_pace_when_its_tasks_end_minutes_apart
   monkeypatch.setattr(progress, "LOG_INTERVAL_S", 0.0)  # Every change is a line.
   now = _clocked(monkeypatch)
   with display.Display(tasks=10, settings=2, show=True) as shown:
-    for done, minutes in ((1, 10), (2, 25), (3, 40)):  # Tasks 15 minutes apart.
+    # Tasks 15 minutes apart, then an hour in which none ends (the display updates every minute).
+    for done, minutes in ((1, 10), (2, 25), (3, 40), (3, 100)):
       now[0] = 60.0 * minutes
       shown.update(done, 2, 0, 0)
   lines = _state_lines(capsys.readouterr().out)
@@ -184,6 +185,13 @@ def test_a_sweeps_time_left_comes_from_its_pace_when_its_tasks_end_minutes_apart
     r"sweep: tasks: 3/10, 2 running, 0 failed, 0/2 records, 1:45:00 left, "
     r"0:40:00 elapsed",
     lines[2],
+  ), lines
+  # An hour on, still 2 tasks since the first: 90 minutes for 2, so the 7 left take 5:15:00
+  # (rich's own estimate stays at 1:45:00 until a task ends).
+  assert re.fullmatch(
+    r"sweep: tasks: 3/10, 2 running, 0 failed, 0/2 records, 5:15:00 left, "
+    r"1:40:00 elapsed",
+    lines[3],
   ), lines
 
 

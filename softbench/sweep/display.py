@@ -15,9 +15,9 @@ class Display:
   workers' bars (``show_workers``).
 
   Running counts the tasks whose inputs are ready, up to the cluster's cores (Ray runs those);
-  the time left is estimated from the pace of the tasks so far (since the first one ended, up to
-  ``progress.PACE_WINDOW_S``), which mixes short evaluations with long trainings; a worker's bar
-  estimates its own work's the same way."""
+  the time left is estimated from the pace of the tasks so far (from the first one's end up to
+  now, at most ``progress.PACE_WINDOW_S``), which mixes short evaluations with long trainings; a
+  worker's bar estimates its own work's the same way."""
 
   def __init__(self, tasks: int, settings: int, show: bool):
     self._progress = progress_bars.counting(
