@@ -2,6 +2,7 @@
 carried to another data home, and records re-scored from it (``softbench zoo``)."""
 
 import json
+import pathlib
 import shutil
 
 import numpy as np
@@ -21,6 +22,7 @@ from softbench.data import dataset as data_files
 from softbench.leaderboard import zoo_catalogue as catalogue
 
 LEARNED_AGENTS = agents.babbling_learners()  # The agents whose weights the zoo keeps.
+CHECKOUT = pathlib.Path(__file__).resolve().parents[1]
 ROBOT = "tendon-2"
 TINY = profiles.get("tiny")
 
@@ -494,3 +496,15 @@ def test_exp1s_networks_come_from_the_zoo(two_stages, tmp_path, monkeypatch, cap
     assert cli.main([*argv, "--results", str(tmp_path / "rescored")]) == 0
   ((_, rescored),) = records.read_folder(tmp_path / "rescored")
   assert rescored["per_seed"] == trained["per_seed"] and rescored["zoo"]["files"]
+
+
+def test_the_repositorys_zoo_is_intact_within_its_budget_and_links_committed_records():
+  committed = CHECKOUT / "zoo"
+  entries = zoo.read_manifest(committed)
+  assert entries, "the repository's zoo lists no file"
+  assert zoo.check_files(committed) == []  # Every file listed, with its sha256; none unlisted.
+  assert all((committed / path).stat().st_size == entry.bytes for path, entry in entries.items())
+  assert zoo.size_bytes(entries) <= zoo.BUDGET_BYTES
+  linked = {record for entry in entries.values() for record in entry.records}
+  missing = sorted(linked - {path.name for path in (CHECKOUT / "leaderboard/results").iterdir()})
+  assert not missing, f"the zoo links records that leaderboard/results lacks: {missing}"
