@@ -316,7 +316,8 @@ def test_a_dry_run_lists_the_settings_without_records_and_runs_nothing(expected,
     "2 settings to run, 0 with records skipped",
     "  zero-tendon-1-circle-tiny-physics: 2 of 2 seeds",
     "  mlp-tendon-1-circle-tiny-physics: 2 of 2 seeds",
-    "to build: dataset 1, forward 2, agent 2, network 0; found in the data home: 0",
+    "to build: dataset 1, forward 2, agent 2, network 0 (0 resuming an unfinished training, run"
+    " first); found in the data home: 0",
   ]
   assert not ray.is_initialized() and not list(results.glob("*"))
   assert not list(storage.softbench_home().glob("*/*"))  # Nothing built.
@@ -326,6 +327,24 @@ def test_a_dry_run_lists_the_settings_without_records_and_runs_nothing(expected,
     "1 settings to run, 1 with records skipped",
     "  zero-tendon-1-circle-tiny-physics: 2 of 2 seeds",
   ]
+
+
+def test_trainings_under_way_are_submitted_before_new_ones(data_home, tmp_path):
+  grid = dataclasses.replace(GRID, tasks=("circle",), agents=("mlp",))
+
+  def order() -> list[str]:
+    plan = sweep_grid.plan(grid, tmp_path / "results")
+    labels = [build.label for build in plan.builds]
+    for build in plan.builds:  # Each after what it needs.
+      assert all(labels.index(need.label) < labels.index(build.label) for need in build.needs)
+    return [build.label for build in plan.builds if build.kind == "agent"]
+
+  assert order() == ["agent mlp tendon-1 seed 0", "agent mlp tendon-1 seed 1"]
+  (seed_1,) = sweep_grid.agent_build("mlp", "tendon-1", 1, profiles.get("tiny")).files
+  (data_home / seed_1).with_suffix(".partial").mkdir(parents=True)  # Its snapshots' folder.
+  assert order() == ["agent mlp tendon-1 seed 1", "agent mlp tendon-1 seed 0"]
+  report = sweep_grid.plan(grid, tmp_path / "results").report()
+  assert "(1 resuming an unfinished training, run first)" in report
 
 
 def test_an_exp1s_record_stands_for_its_own_family_only(tmp_path):

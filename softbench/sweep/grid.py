@@ -146,7 +146,11 @@ class Plan:
       lines.append(f"  {setting_name(run)}: {run.seeds - resumed} of {run.seeds} seeds{kept}")
     to_build = [build for build in self.builds if build not in self.found]
     counts = ", ".join(f"{kind} {sum(build.kind == kind for build in to_build)}" for kind in KINDS)
-    lines.append(f"to build: {counts}; found in the data home: {len(self.found)}")
+    resuming = sum(resumes(build) for build in to_build)
+    lines.append(
+      f"to build: {counts} ({resuming} resuming an unfinished training, run first);"
+      f" found in the data home: {len(self.found)}"
+    )
     return "\n".join(lines)
 
 
@@ -266,6 +270,26 @@ def is_found(build: Build) -> bool:
   return bool(build.files) and all((home / name).is_file() for name in build.files)
 
 
+UNFINISHED_SUFFIXES = (".partial", ".partial.pt")
+"""Where a cache file's unfinished training keeps its state, beside it: ``KEY.partial/`` (a
+babbling learner, a forward model; ``smpl.snapshots``) or ``KEY.partial.pt`` (sac)."""
+
+
+def resumes(build: Build) -> bool:
+  """Whether the data home holds the state of an unfinished training of ``build`` itself."""
+  home = storage.softbench_home()
+  return any(
+    (home / name).with_suffix(suffix).exists()
+    for name in build.files
+    for suffix in UNFINISHED_SUFFIXES
+  )
+
+
+def is_under_way(build: Build) -> bool:
+  """Whether ``build`` or a build it needs resumes an unfinished training."""
+  return resumes(build) or any(is_under_way(need) for need in build.needs)
+
+
 def _zoo_key(run: Setting) -> tuple:
   """What the checkpoints that ``run`` takes from the zoo depend on (shared by a task's runs)."""
   if isinstance(run, continual.RunSettings):
@@ -331,9 +355,11 @@ def plan(grid: Grid, results: pathlib.Path) -> Plan:
         add(need)
     builds[build] = None
 
-  for evaluation in evaluations:
-    if evaluation.agent is not None:
-      add(evaluation.agent)
+  # Work under way first: trainings that resume end before new ones start (Ray runs the ready
+  # tasks in submission order), so fewer unfinished states wait, here or in the zoo.
+  agents = [evaluation.agent for evaluation in evaluations if evaluation.agent is not None]
+  for agent in sorted(agents, key=lambda build: not is_under_way(build)):
+    add(agent)
   return Plan(
     tuple(pending),
     tuple(skipped),
