@@ -11,6 +11,7 @@ import os
 import pathlib
 import re
 import signal
+import socket
 import threading
 import time
 
@@ -278,6 +279,19 @@ def test_an_address_where_no_cluster_answers_is_one_line(tmp_path):
   with pytest.raises(ValueError, match="HOST:PORT"):
     run_sweep(zero, tmp_path / "results", "head-without-port")
   assert not ray.is_initialized()
+
+
+def test_an_address_where_something_else_answers_is_one_line(tmp_path, monkeypatch, capsys):
+  def refused(address):  # What ray.init raises after about 20 s of retries there.
+    raise ConnectionError(f"Failed to connect to Ray cluster at {address}")
+
+  monkeypatch.setattr(ray, "init", refused)
+  with socket.create_server(("", 0)) as listener:  # Answers, but is no Ray head.
+    address = f"127.0.0.1:{listener.getsockname()[1]}"
+    argv = ["sweep", "--robots", "tendon-1", "--tasks", "circle", "--agents", "zero"]
+    assert cli.main([*argv, "--address", address, "--results", str(tmp_path)]) == cli.EXIT_USAGE
+  error = capsys.readouterr().err
+  assert error.count("\n") == 1 and f"no Ray cluster at {address}: something answers" in error
 
 
 def test_a_record_stands_for_its_setting_only_with_its_seeds_and_target_completion(

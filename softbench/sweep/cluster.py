@@ -13,6 +13,7 @@ import socket
 import ray
 from ray.util import scheduling_strategies
 
+from smpl.files import first_line
 from softbench import episode_snapshots
 from softbench import storage
 from softbench import zoo
@@ -37,7 +38,13 @@ def connected(address: str | None) -> Iterator[None]:
     ray.init(num_cpus=os.cpu_count(), include_dashboard=False)
   else:
     _check_answers(address)
-    ray.init(address=address)
+    try:
+      ray.init(address=address)
+    except ConnectionError as error:  # Something answers there, but not a Ray head.
+      raise ValueError(
+        f"no Ray cluster at {address}: something answers there, but Ray cannot join it"
+        f" ({first_line(error)}); start one with ray start --head"
+      ) from None
   try:
     yield
   finally:
