@@ -5,7 +5,9 @@ import importlib.util
 import json
 import pathlib
 import re
+import signal
 import sys
+import threading
 
 import pytest
 
@@ -275,3 +277,43 @@ def test_smpl_joint_columns_trains_every_column_at_once_and_reads_the_record(
   (acted_line,) = re.findall(r"^smpl joint columns, acted preceding .*$", acted, re.MULTILINE)
   assert re.search(r"position error ([0-9.]+) mm", acted_line).group(1) != joint
   assert joint != recorded  # Trained otherwise, so scored otherwise.
+
+
+def test_sweep_vs_loop_times_both_ways_to_the_same_records_and_resumes(
+  monkeypatch, capsys, tmp_path
+):
+  work = tmp_path / "grid"
+  grid = ["--robots", "tendon-1", "--tasks", "circle", "--agents", "zero"]
+  grid += ["--profile", "tiny", "--seeds", "2", "--work", str(work)]
+  for way in ("loop", "sweep", "loop"):  # The second loop finds its record: nothing to run.
+    run_script("sweep_vs_loop", [*grid, "--way", way], monkeypatch, capsys)
+  out = run_script("sweep_vs_loop", ["--work", str(work), "--report"], monkeypatch, capsys)
+  lines = out.splitlines()
+  assert re.fullmatch(
+    r"loop: [0-9.]+ s in 1 stretches \(0 interrupted\); 1 records, [0-9.]+ s of runs", lines[0]
+  )
+  assert re.fullmatch(r"sweep: [0-9.]+ s in 1 stretches \(0 interrupted\); 1 records", lines[1])
+  assert lines[2:] == ["records of both ways: 1, with the same scores seed for seed: 1"]
+  for way in ("loop", "sweep"):  # Each in a data home of its own.
+    assert (work / way / "home").is_dir()
+
+
+def test_sweep_vs_loop_counts_an_interrupted_stretch_and_passes_the_interruption_on(tmp_path):
+  spec = importlib.util.spec_from_file_location("timing", ANALYSIS / "sweep_vs_loop.py")
+  timing = importlib.util.module_from_spec(spec)
+  spec.loader.exec_module(timing)
+  saved = tmp_path / "saved"  # The command's "resumable state", written when Ctrl-C reaches it.
+  command = [
+    sys.executable,
+    "-c",
+    "import pathlib, time\n"
+    "try:\n  time.sleep(60)\n"
+    f"except KeyboardInterrupt:\n  pathlib.Path({str(saved)!r}).touch(); raise SystemExit(130)",
+  ]
+  main = threading.get_ident()
+  threading.Timer(2.0, signal.pthread_kill, (main, signal.SIGINT)).start()
+  with pytest.raises(KeyboardInterrupt):
+    timing._timed(command, tmp_path, "sleeper")
+  (stretch,) = [json.loads(line) for line in (tmp_path / "times.jsonl").read_text().splitlines()]
+  assert stretch["interrupted"] and stretch["returncode"] == 130 and saved.exists()
+  assert 1.5 < stretch["seconds"] < 30
