@@ -40,7 +40,8 @@ MANIFEST = "manifest.json"
 FORMAT = "softbench-zoo"
 VERSION = 1
 KINDS = ("agent", "forward", "training-state")
-BUDGET_BYTES = 100 * 2**20  # (bytes) What the repository's zoo may hold in all.
+MB = 10**6  # (bytes) A megabyte, as the zoo's sizes are given.
+BUDGET_BYTES = 100 * MB  # (bytes) What the repository's zoo may hold in all: 100 MB.
 PARTIAL_SUFFIX = ".partial"  # A cache file's training state: KEY.partial/ beside KEY.pt.
 _REPOSITORY_ZOO = pathlib.Path(__file__).resolve().parents[2] / "zoo"  # Of a source checkout.
 
@@ -315,8 +316,8 @@ def add(
   total = size_bytes(updated)
   if budget_bytes is not None and total > budget_bytes:
     raise ValueError(
-      f"the zoo would hold {total / 2**20:.1f} MiB, over its budget of "
-      f"{budget_bytes / 2**20:.0f} MiB; nothing was added"
+      f"the zoo would hold {total / MB:.1f} MB, over its budget of "
+      f"{budget_bytes / MB:.0f} MB; nothing was added"
     )
   for path, (content, _) in planned.items():
     storage.write_atomically(zoo / path, content)

@@ -9,14 +9,15 @@ from rich.console import RenderableType
 from softbench import terminal
 from softbench import zoo
 
-KIB = 2**10  # (bytes)
-MIB = 2**20  # (bytes)
+KB = 10**3  # (bytes) A kilobyte.
 
 
 def usage(folder: pathlib.Path, entries: dict[str, zoo.Entry]) -> str:
-  """``1.2 MiB of 100 MiB (FOLDER)``: what ``entries`` (the zoo ``folder``'s) hold of its
+  """``1.2 MB of 100 MB (FOLDER)``: what ``entries`` (the zoo ``folder``'s) hold of its
   budget."""
-  return f"{zoo.size_bytes(entries) / MIB:.1f} MiB of {zoo.BUDGET_BYTES / MIB:.0f} MiB ({folder})"
+  return (
+    f"{zoo.size_bytes(entries) / zoo.MB:.1f} MB of {zoo.BUDGET_BYTES / zoo.MB:.0f} MB ({folder})"
+  )
 
 
 def contents(folder: pathlib.Path) -> RenderableType:
@@ -24,11 +25,11 @@ def contents(folder: pathlib.Path) -> RenderableType:
   file against the manifest."""
   entries = zoo.read_manifest(folder)
   rows = [
-    [entry.kind, f"{entry.bytes / KIB:.1f}", str(len(entry.records)), path]
+    [entry.kind, f"{entry.bytes / KB:.1f}", str(len(entry.records)), path]
     for path, entry in sorted(entries.items())
   ]
   return Group(
-    terminal.table(("kind", "KiB", "records", "path"), rows, right=("KiB", "records")),
+    terminal.table(("kind", "kB", "records", "path"), rows, right=("kB", "records")),
     f"{len(entries)} files, {usage(folder, entries)}",
     *(f"problem: {problem}" for problem in zoo.check_files(folder)),
   )
@@ -44,7 +45,7 @@ def additions(
   unlinked because they name no weights (``unchecked``), then how much the zoo ``folder`` holds
   now; one fact a line."""
   lines = [
-    f"added {entry.path} ({entry.kind}, {entry.bytes / KIB:.1f} KiB, {len(entry.records)} records)"
+    f"added {entry.path} ({entry.kind}, {entry.bytes / KB:.1f} kB, {len(entry.records)} records)"
     for entry in added
   ]
   lines += [
@@ -61,6 +62,6 @@ def additions(
 
 def removals(removed: list[zoo.Entry], folder: pathlib.Path) -> str:
   """What ``zoo.remove`` removed, then how much the zoo ``folder`` holds now; one fact a line."""
-  lines = [f"removed {entry.path} ({entry.kind}, {entry.bytes / KIB:.1f} KiB)" for entry in removed]
+  lines = [f"removed {entry.path} ({entry.kind}, {entry.bytes / KB:.1f} kB)" for entry in removed]
   lines.append(f"zoo: {usage(folder, zoo.read_manifest(folder))}")
   return "\n".join(lines)
