@@ -355,8 +355,9 @@ def plan(grid: Grid, results: pathlib.Path) -> Plan:
         add(need)
     builds[build] = None
 
-  # Work under way first: trainings that resume end before new ones start (Ray runs the ready
-  # tasks in submission order), so fewer unfinished states wait, here or in the zoo.
+  # Work under way first: trainings that resume end before new ones start (Ray starts ready
+  # tasks in about the order they were submitted), so fewer unfinished states wait, here or in
+  # the zoo.
   agents = [evaluation.agent for evaluation in evaluations if evaluation.agent is not None]
   for agent in sorted(agents, key=lambda build: not is_under_way(build)):
     add(agent)
