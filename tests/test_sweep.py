@@ -281,6 +281,16 @@ def test_an_address_where_no_cluster_answers_is_one_line(tmp_path):
   assert not ray.is_initialized()
 
 
+def test_without_an_address_the_sweep_starts_its_own_ray_whatever_ray_address_says(
+  address, tmp_path, monkeypatch
+):
+  monkeypatch.setenv("RAY_ADDRESS", address)  # Ray's own default: join the cluster it names.
+  zero = dataclasses.replace(GRID, tasks=("circle",), agents=("zero",), seeds=1)
+  (written,) = run_sweep(zero, tmp_path / "results", None).written
+  assert records.read(written)["agent"] == "zero"  # Before: ray.init refused num_cpus there.
+  assert not ray.is_initialized()
+
+
 def test_an_address_where_something_else_answers_is_one_line(tmp_path, monkeypatch, capsys):
   def refused(address):  # What ray.init raises after about 20 s of retries there.
     raise ConnectionError(f"Failed to connect to Ray cluster at {address}")

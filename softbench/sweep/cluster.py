@@ -35,7 +35,8 @@ def connected(address: str | None) -> Iterator[None]:
     yield
     return
   if address is None:
-    ray.init(num_cpus=os.cpu_count(), include_dashboard=False)
+    # "local": a Ray of its own even where RAY_ADDRESS or a running `ray start` names another.
+    ray.init(address="local", num_cpus=os.cpu_count(), include_dashboard=False)
   else:
     _check_answers(address)
     try:
