@@ -270,7 +270,7 @@ def is_found(build: Build) -> bool:
   return bool(build.files) and all((home / name).is_file() for name in build.files)
 
 
-UNFINISHED_SUFFIXES = (".partial", ".partial.pt")
+UNFINISHED_SUFFIXES = (zoo.PARTIAL_SUFFIX, ".partial.pt")
 """Where a cache file's unfinished training keeps its state, beside it: ``KEY.partial/`` (a
 babbling learner, a forward model; ``smpl.snapshots``) or ``KEY.partial.pt`` (sac)."""
 
