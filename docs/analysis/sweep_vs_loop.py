@@ -158,4 +158,8 @@ def main() -> None:
 
 if __name__ == "__main__":
   signal.signal(signal.SIGTERM, signal.default_int_handler)  # `kill` stops it as Ctrl-C does.
+  # Started in the background of a script (nohup ... &), a process ignores SIGINT, and so would
+  # the runs it starts, which then finished a setting rather than stop when interrupted; a
+  # handler of its own makes their SIGINT the default again.
+  signal.signal(signal.SIGINT, signal.default_int_handler)
   main()
