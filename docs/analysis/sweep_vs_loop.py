@@ -1,17 +1,28 @@
 """Wall time of a leaderboard grid: one `softbench sweep` against the loop that it replaced.
 
 The loop is `make leaderboard`'s before the sweep (8ecea43): one `softbench run` per setting,
-robot > task > agent, skipping a setting that has a record. Each way runs from an empty data home
-of its own with the zoo off, under WORK/WAY/ (`home/`, `results/`). Both resume: stopped (Ctrl-C,
-SIGTERM) and started again, a way goes on where it was. Every stretch of wall time it ran, whole
-or cut short, is appended to WORK/WAY/times.jsonl, so a total adds up across restarts and
-sessions (what an interruption loses is paid again, and counted).
+robot > task > agent, skipping a setting that has a record.
+
+The grid is measured in parts (PARTS: sets of agents, each over every task and seed), so that
+each way of each part fits in one session of a machine that may not outlive it. The babbling
+dataset, which every learned agent needs, is collected once (`--way dataset`, timed) and copied
+into each way's data home before it starts, so it is counted once, not once a part. Each way of
+a part runs from that data home, of its own, with the zoo off, under WORK/PART/WAY/ (`home/`,
+`results/`). Both resume on the same machine: stopped (Ctrl-C, SIGTERM) and started again, a way
+goes on where it was; every stretch of wall time it ran, whole or cut short, is appended to
+WORK/PART/WAY/times.jsonl (what an interruption loses is paid again, and counted). A way that
+ends writes WORK/PART/WAY/finished.json (its total, and every record's scores seed for seed):
+commit those files, with the times, and `--report` adds them up on any machine.
+
+A part's sweep loses, against one sweep of the whole grid, the cores left idle at the part's
+end, and pays its Ray start again, so the parts' sum is an upper bound on the whole sweep.
 
 Usage:
-  python docs/analysis/sweep_vs_loop.py --work /work/runs/grid --way loop
-  python docs/analysis/sweep_vs_loop.py --work /work/runs/grid --way sweep
-  python docs/analysis/sweep_vs_loop.py --work /work/runs/grid --report
-(defaults: tendon-3, the leaderboard's tasks and agents, the default profile, 5 seeds)
+  python docs/analysis/sweep_vs_loop.py --work /work/runs/grid --way dataset
+  python docs/analysis/sweep_vs_loop.py --work /work/runs/grid --part learners --way loop
+  python docs/analysis/sweep_vs_loop.py --work /work/runs/grid --part learners --way sweep
+  python docs/analysis/sweep_vs_loop.py --work docs/analysis/sweep_vs_loop --report
+(defaults: tendon-3, the leaderboard's tasks, the default profile, 5 seeds)
 """
 
 import argparse
@@ -19,6 +30,7 @@ import datetime
 import json
 import os
 import pathlib
+import shutil
 import signal
 import subprocess
 import sys
@@ -28,9 +40,18 @@ from softbench import profiles
 from softbench import records
 from softbench import storage
 from softbench import zoo
+from softbench.agents import learned
+from softbench.data import dataset as babbling_dataset
 from softbench.leaderboard import grid
 
 WAYS = ("loop", "sweep")
+PARTS = {  # The issue's grid: the eight agents of its time (the reference came later).
+  "learners": ("smpl", "mlp", "lstm", "vae-lstm"),
+  "bilstm": ("bilstm",),
+  "sac": ("sac",),
+  "baselines": ("zero", "random"),
+}
+DATASET = "dataset"  # The folder of the babbling dataset's collection, beside the parts'.
 GRACE_S = 300.0  # (s) How long an interrupted command has to save its state before it is killed.
 
 
@@ -79,77 +100,141 @@ def _timed(command: list[str], folder: pathlib.Path, what: str) -> int:
   return returncode
 
 
+def _dataset_folder(args: argparse.Namespace, home: pathlib.Path) -> pathlib.Path:
+  config = babbling_dataset.generating_config(
+    args.robot, profiles.get(args.profile).samples, learned.DATA_SEED
+  )
+  return babbling_dataset.dataset_folder(config, home)
+
+
+def collect_dataset(args: argparse.Namespace) -> None:
+  """Collects the runs' babbling dataset once, timed as a way of its own."""
+  folder = args.work / DATASET
+  folder.mkdir(parents=True, exist_ok=True)
+  samples = str(profiles.get(args.profile).samples)
+  command = _command(
+    "collect", "--robot", args.robot, "--samples", samples, "--seed", str(learned.DATA_SEED)
+  )
+  if _timed(command, folder, "collect"):
+    raise SystemExit("the collection failed; see its output above")
+  _finish(folder, {})
+
+
+def _seed_home(args: argparse.Namespace, folder: pathlib.Path) -> None:
+  """Copies the collected dataset into the way's data home (before its first stretch)."""
+  source = _dataset_folder(args, args.work / DATASET / "home")
+  target = _dataset_folder(args, folder / "home")
+  if target.exists():
+    return
+  if not (args.work / DATASET / "finished.json").exists():
+    raise SystemExit(f"collect the dataset first: --work {args.work} --way {DATASET}")
+  target.parent.mkdir(parents=True, exist_ok=True)
+  shutil.copytree(source, target.with_name(target.name + ".copying"))
+  os.replace(target.with_name(target.name + ".copying"), target)
+
+
+def _finish(folder: pathlib.Path, scores: dict) -> None:
+  """Writes the way's total and its records' scores seed for seed to ``folder/finished.json``."""
+  stretches = [json.loads(line) for line in (folder / "times.jsonl").read_text().splitlines()]
+  summary = {
+    "seconds": round(sum(stretch["seconds"] for stretch in stretches), 3),
+    "stretches": len(stretches),
+    "interrupted": sum(stretch["interrupted"] for stretch in stretches),
+    "ended": stretches[-1]["ended"],
+    "per_seed": scores,
+  }
+  storage.write_atomically(folder / "finished.json", json.dumps(summary, indent=1) + "\n")
+
+
 def run_way(args: argparse.Namespace) -> None:
-  folder = args.work / args.way
+  folder = args.work / args.part / args.way
   results = folder / "results"
   results.mkdir(parents=True, exist_ok=True)
+  _seed_home(args, folder)
+  agents = PARTS[args.part]
   shared = ["--profile", args.profile, "--seeds", str(args.seeds), "--results", str(results)]
   if args.way == "sweep":
     command = _command(
-      "sweep", "--robots", *args.robots, "--tasks", *args.tasks, "--agents", *args.agents, *shared
+      "sweep", "--robots", args.robot, "--tasks", *args.tasks, "--agents", *agents, *shared
     )
     if _timed(command, folder, "sweep"):
       raise SystemExit("the sweep failed; see its output above")
-    return
-  for robot in args.robots:
+  else:
     for task in args.tasks:
-      for agent in args.agents:
-        if _has_record(results, agent, robot, task, args.profile):
+      for agent in agents:
+        if _has_record(results, agent, args.robot, task, args.profile):
           continue
-        command = _command("run", "--robot", robot, "--task", task, "--agent", agent, *shared)
-        if _timed(command, folder, f"{agent}-{robot}-{task}"):
-          raise SystemExit(f"softbench run failed on {agent}-{robot}-{task}; see above")
+        command = _command("run", "--robot", args.robot, "--task", task, "--agent", agent, *shared)
+        if _timed(command, folder, f"{agent}-{args.robot}-{task}"):
+          raise SystemExit(f"softbench run failed on {agent}-{args.robot}-{task}; see above")
+  scores = {
+    "-".join(record[key] for key in ("agent", "robot", "task")): record["per_seed"]
+    for _, record in records.read_folder(results)
+  }
+  _finish(folder, scores)
+
+
+def _finished(folder: pathlib.Path) -> dict | None:
+  path = folder / "finished.json"
+  return json.loads(path.read_text()) if path.exists() else None
 
 
 def report(work: pathlib.Path) -> None:
-  """Each way's wall time (its stretches added up) and whether the two ways' records agree."""
-  written = {}
-  for way in WAYS:
-    path = work / way / "times.jsonl"
-    stretches = (
-      [json.loads(line) for line in path.read_text().splitlines()] if path.exists() else []
+  """Each finished part's two wall times, their sums with the dataset's collection, and whether
+  the two ways' records agree seed for seed."""
+  dataset = _finished(work / DATASET)
+  print(f"dataset: {dataset['seconds']:.1f} s" if dataset else "dataset: not collected")
+  totals, both, same = {way: 0.0 for way in WAYS}, 0, 0
+  for part, agents in PARTS.items():
+    ways = {way: _finished(work / part / way) for way in WAYS}
+    print(
+      f"{part} ({' '.join(agents)}): "
+      + ", ".join(
+        f"{way} {ways[way]['seconds']:.1f} s in {ways[way]['stretches']} stretches"
+        f" ({ways[way]['interrupted']} interrupted)"
+        if ways[way]
+        else f"{way} not finished"
+        for way in WAYS
+      )
     )
-    cut = sum(stretch["interrupted"] for stretch in stretches)
-    total = sum(stretch["seconds"] for stretch in stretches)
-    written[way] = (
-      {
-        "-".join(record[key] for key in ("agent", "robot", "task")): record
-        for _, record in records.read_folder(work / way / "results")
-      }
-      if (work / way / "results").is_dir()
-      else {}
-    )
-    line = f"{way}: {total:.1f} s in {len(stretches)} stretches ({cut} interrupted); "
-    line += f"{len(written[way])} records"
-    if way == "loop":  # A run's record times its work, not its process starting and importing.
-      line += f", {sum(record['wall_time_s'] for record in written[way].values()):.1f} s of runs"
-    print(line)
-  both = sorted(set(written["loop"]) & set(written["sweep"]))
-  same = [
-    name for name in both if written["loop"][name]["per_seed"] == written["sweep"][name]["per_seed"]
-  ]
-  print(f"records of both ways: {len(both)}, with the same scores seed for seed: {len(same)}")
-  for name in sorted(set(both) - set(same)):
-    print(f"  scores differ: {name}")
+    if not all(ways.values()):
+      continue
+    for way in WAYS:
+      totals[way] += ways[way]["seconds"]
+    names = sorted(set(ways["loop"]["per_seed"]) & set(ways["sweep"]["per_seed"]))
+    differ = [
+      name for name in names if ways["loop"]["per_seed"][name] != ways["sweep"]["per_seed"][name]
+    ]
+    both, same = both + len(names), same + len(names) - len(differ)
+    for name in differ:
+      print(f"  scores differ: {name}")
+  collect = dataset["seconds"] if dataset else 0.0
+  print(
+    ", ".join(f"{way}: {totals[way] + collect:.1f} s" for way in WAYS)
+    + " (the finished parts and the dataset's collection)"
+  )
+  print(f"records of both ways: {both}, with the same scores seed for seed: {same}")
 
 
 def main() -> None:
   axes = grid.lists()
   parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
   parser.add_argument("--work", type=pathlib.Path, required=True, help="the measurement's folder")
-  parser.add_argument("--way", choices=WAYS, help="run (or resume) this way")
-  parser.add_argument("--report", action="store_true", help="print both ways' figures so far")
-  parser.add_argument("--robots", nargs="+", default=["tendon-3"])
+  parser.add_argument("--way", choices=(DATASET, *WAYS), help="run (or resume) this way")
+  parser.add_argument("--part", choices=PARTS, help="the part of the grid (for loop and sweep)")
+  parser.add_argument("--report", action="store_true", help="print the finished parts' figures")
+  parser.add_argument("--robot", default="tendon-3")
   parser.add_argument("--tasks", nargs="+", default=list(axes["tasks"]))
-  parser.add_argument("--agents", nargs="+", default=list(axes["agents"]))
   parser.add_argument("--profile", default=profiles.DEFAULT_PROFILE)
   parser.add_argument("--seeds", type=int, default=profiles.get(profiles.DEFAULT_PROFILE).seeds)
   args = parser.parse_args()
   if (args.way is None) == (not args.report):
     parser.error("give either --way or --report")
+  if args.way in WAYS and args.part is None:
+    parser.error(f"--way {args.way} needs --part")
   if args.way is not None:
     try:
-      run_way(args)
+      collect_dataset(args) if args.way == DATASET else run_way(args)
     except KeyboardInterrupt:
       raise SystemExit(f"interrupted; run the same command again to resume the {args.way}")
   else:
