@@ -11,7 +11,7 @@ a part runs from that data home, of its own, with the zoo off, under WORK/PART/W
 `results/`). Both resume on the same machine: stopped (Ctrl-C, SIGTERM) and started again, a way
 goes on where it was; every stretch of wall time it ran, whole or cut short, is appended to
 WORK/PART/WAY/times.jsonl (what an interruption loses is paid again, and counted). A way that
-ends writes WORK/PART/WAY/finished.json (its total, and every record's scores seed for seed):
+ends writes WORK/PART/WAY/finished.json (its total, and a digest of every record's scores):
 commit those files, with the times, and `--report` adds them up on any machine.
 
 A part's sweep loses, against one sweep of the whole grid, the cores left idle at the part's
@@ -27,6 +27,7 @@ Usage:
 
 import argparse
 import datetime
+import hashlib
 import json
 import os
 import pathlib
@@ -133,15 +134,33 @@ def _seed_home(args: argparse.Namespace, folder: pathlib.Path) -> None:
   os.replace(target.with_name(target.name + ".copying"), target)
 
 
-def _finish(folder: pathlib.Path, scores: dict) -> None:
-  """Writes the way's total and its records' scores seed for seed to ``folder/finished.json``."""
+def _per_seed(results: pathlib.Path) -> dict[str, list[dict]]:
+  """Each record's scores seed for seed, by AGENT-ROBOT-TASK."""
+  return {
+    "-".join(record[key] for key in ("agent", "robot", "task")): record["per_seed"]
+    for _, record in records.read_folder(results)
+  }
+
+
+def scores(per_seed: list[dict]) -> dict:
+  """A record's scores in brief: the sha256 of all of them, seed for seed (what two ways compare),
+  and each seed's mean position error (mm), to read."""
+  canonical = json.dumps(per_seed, sort_keys=True).encode()
+  return {
+    "sha256": hashlib.sha256(canonical).hexdigest(),
+    "position_mm": [seed["position_mm"]["mean"] for seed in per_seed],
+  }
+
+
+def _finish(folder: pathlib.Path, digests: dict) -> None:
+  """Writes the way's total and its records' ``digests`` to ``folder/finished.json``."""
   stretches = [json.loads(line) for line in (folder / "times.jsonl").read_text().splitlines()]
   summary = {
     "seconds": round(sum(stretch["seconds"] for stretch in stretches), 3),
     "stretches": len(stretches),
     "interrupted": sum(stretch["interrupted"] for stretch in stretches),
     "ended": stretches[-1]["ended"],
-    "per_seed": scores,
+    "scores": digests,
   }
   storage.write_atomically(folder / "finished.json", json.dumps(summary, indent=1) + "\n")
 
@@ -167,11 +186,7 @@ def run_way(args: argparse.Namespace) -> None:
         command = _command("run", "--robot", args.robot, "--task", task, "--agent", agent, *shared)
         if _timed(command, folder, f"{agent}-{args.robot}-{task}"):
           raise SystemExit(f"softbench run failed on {agent}-{args.robot}-{task}; see above")
-  scores = {
-    "-".join(record[key] for key in ("agent", "robot", "task")): record["per_seed"]
-    for _, record in records.read_folder(results)
-  }
-  _finish(folder, scores)
+  _finish(folder, {name: scores(per_seed) for name, per_seed in _per_seed(results).items()})
 
 
 def _finished(folder: pathlib.Path) -> dict | None:
@@ -201,10 +216,10 @@ def report(work: pathlib.Path) -> None:
       continue
     for way in WAYS:
       totals[way] += ways[way]["seconds"]
-    names = sorted(set(ways["loop"]["per_seed"]) & set(ways["sweep"]["per_seed"]))
-    differ = [
-      name for name in names if ways["loop"]["per_seed"][name] != ways["sweep"]["per_seed"][name]
-    ]
+    print(f"  the sweep took {ways['sweep']['seconds'] / ways['loop']['seconds']:.2f} of the loop")
+    loop, sweep = ways["loop"]["scores"], ways["sweep"]["scores"]
+    names = sorted(set(loop) & set(sweep))
+    differ = [name for name in names if loop[name]["sha256"] != sweep[name]["sha256"]]
     both, same = both + len(names), same + len(names) - len(differ)
     for name in differ:
       print(f"  scores differ: {name}")
