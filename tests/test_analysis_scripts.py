@@ -279,23 +279,41 @@ def test_smpl_joint_columns_trains_every_column_at_once_and_reads_the_record(
   assert joint != recorded  # Trained otherwise, so scored otherwise.
 
 
-def test_sweep_vs_loop_times_both_ways_to_the_same_records_and_resumes(
+def test_sweep_vs_loop_times_a_part_both_ways_to_the_same_records_and_resumes(
   monkeypatch, capsys, tmp_path
 ):
   work = tmp_path / "grid"
-  grid = ["--robots", "tendon-1", "--tasks", "circle", "--agents", "zero"]
-  grid += ["--profile", "tiny", "--seeds", "2", "--work", str(work)]
-  for way in ("loop", "sweep", "loop"):  # The second loop finds its record: nothing to run.
-    run_script("sweep_vs_loop", [*grid, "--way", way], monkeypatch, capsys)
+  grid = ["--robot", "tendon-1", "--tasks", "circle", "--profile", "tiny", "--seeds", "2"]
+  grid += ["--work", str(work)]
+  part = [*grid, "--part", "baselines", "--way"]
+  with pytest.raises(SystemExit, match="collect the dataset first"):
+    run_script("sweep_vs_loop", [*part, "loop"], monkeypatch, capsys)
+  run_script("sweep_vs_loop", [*grid, "--way", "dataset"], monkeypatch, capsys)
+  for way in ("loop", "sweep", "loop"):  # The second loop finds its records: nothing to run.
+    run_script("sweep_vs_loop", [*part, way], monkeypatch, capsys)
   out = run_script("sweep_vs_loop", ["--work", str(work), "--report"], monkeypatch, capsys)
   lines = out.splitlines()
+  assert re.fullmatch(r"dataset: [0-9.]+ s", lines[0])
+  assert lines[1:4] == [
+    "learners (smpl mlp lstm vae-lstm): loop not finished, sweep not finished",
+    "bilstm (bilstm): loop not finished, sweep not finished",
+    "sac (sac): loop not finished, sweep not finished",
+  ]
+  number = "[0-9.]+"
   assert re.fullmatch(
-    r"loop: [0-9.]+ s in 1 stretches \(0 interrupted\); 1 records, [0-9.]+ s of runs", lines[0]
+    rf"baselines \(zero random\): loop {number} s in 2 stretches \(0 interrupted\), "
+    rf"sweep {number} s in 1 stretches \(0 interrupted\)",
+    lines[4],
   )
-  assert re.fullmatch(r"sweep: [0-9.]+ s in 1 stretches \(0 interrupted\); 1 records", lines[1])
-  assert lines[2:] == ["records of both ways: 1, with the same scores seed for seed: 1"]
-  for way in ("loop", "sweep"):  # Each in a data home of its own.
-    assert (work / way / "home").is_dir()
+  assert re.fullmatch(rf"  the sweep took {number} of the loop", lines[5])
+  assert re.fullmatch(rf"loop: {number} s, sweep: {number} s \(.*\)", lines[6])
+  assert lines[7:] == ["records of both ways: 2, with the same scores seed for seed: 2"]
+  collected = sorted(path.name for path in (work / "dataset" / "home" / "datasets").iterdir())
+  for way in ("loop", "sweep"):  # Each in a data home of its own, holding the collected dataset.
+    home = work / "baselines" / way / "home"
+    assert sorted(path.name for path in (home / "datasets").iterdir()) == collected
+    finished = json.loads((work / "baselines" / way / "finished.json").read_text())
+    assert sorted(finished["scores"]) == ["random-tendon-1-circle", "zero-tendon-1-circle"]
 
 
 def test_sweep_vs_loop_counts_an_interrupted_stretch_and_passes_the_interruption_on(tmp_path):
