@@ -129,9 +129,11 @@ def _seed_home(args: argparse.Namespace, folder: pathlib.Path) -> None:
     return
   if not (args.work / DATASET / "finished.json").exists():
     raise SystemExit(f"collect the dataset first: --work {args.work} --way {DATASET}")
-  target.parent.mkdir(parents=True, exist_ok=True)
-  shutil.copytree(source, target.with_name(target.name + ".copying"))
-  os.replace(target.with_name(target.name + ".copying"), target)
+  partial = target.with_name(target.name + ".copying")
+  shutil.rmtree(partial, ignore_errors=True)  # A copy cut short by a stop.
+  partial.parent.mkdir(parents=True, exist_ok=True)
+  shutil.copytree(source, partial)
+  os.replace(partial, target)
 
 
 def _per_seed(results: pathlib.Path) -> dict[str, list[dict]]:
