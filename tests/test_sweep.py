@@ -32,6 +32,7 @@ from softbench import sweep
 from softbench import zoo
 from softbench.agents import learned
 from softbench.sweep import display
+from softbench.sweep import execution
 from softbench.sweep import grid as sweep_grid
 
 GRID = sweep.Grid(("tendon-1",), ("circle", "reach"), ("mlp", "zero"), "tiny", 2)
@@ -369,6 +370,33 @@ def test_trainings_under_way_are_submitted_before_new_ones(data_home, tmp_path):
   assert order() == ["agent mlp tendon-1 seed 1", "agent mlp tendon-1 seed 0"]
   report = sweep_grid.plan(grid, tmp_path / "results").report()
   assert "(1 resuming an unfinished training, run first)" in report
+
+
+def test_evaluations_wait_while_the_runnable_builds_fill_every_core(tmp_path):
+  """Ray shares cores fairly between kinds of task, so an evaluation submitted while trainings
+  wait for a core would delay them: it is held until the runnable builds leave a core free."""
+  grid = dataclasses.replace(GRID, tasks=("circle",), agents=("mlp", "zero"), seeds=3)
+  plan = sweep_grid.plan(grid, tmp_path / "results")
+  agents = [build for build in plan.builds if build.kind == "agent"]
+  forward = {need for agent in agents for need in agent.needs}
+  built = {need for build in forward for need in build.needs} | forward  # The agents' needs.
+  held = list(plan.evaluations)
+  baselines = [evaluation for evaluation in held if evaluation.agent is None]
+  assert len(agents) == 3 and len(baselines) == 3
+
+  def released(finished: set, cores: int) -> list:
+    return execution.releasable(held, plan.builds, finished, cores, build_cores=lambda build: 1)
+
+  assert released(set(), cores=1) == []  # The dataset's collection fills the only core.
+  assert released(set(), cores=2) == baselines  # It leaves one: those that need no agent.
+  assert released(built, cores=2) == []  # Three trainings can run on two cores.
+  assert released(built, cores=4) == baselines  # A core left: those that need no agent.
+  assert released(built | {agents[0]}, cores=2) == []  # Two trainings still fill both cores.
+  # One training left on two cores: the evaluations whose agents are built, not the third's.
+  assert released(built | set(agents[:2]), cores=2) == [
+    evaluation for evaluation in held if evaluation.agent is None or evaluation.agent in agents[:2]
+  ]
+  assert released(built | set(agents), cores=1) == held  # Every build done: all of them.
 
 
 def test_an_exp1s_record_stands_for_its_own_family_only(tmp_path):

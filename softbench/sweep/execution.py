@@ -2,7 +2,10 @@
 
 Each build and each evaluation is one Ray task of one core (a babbling collection: up to
 ``cluster.COLLECTION_CORES``), given the results of the builds it needs, so Ray runs the graph in
-its order and in parallel; a build the data home holds is shipped instead (``shipping``). A task
+its order and in parallel; a build the data home holds is shipped instead (``shipping``). The
+builds are submitted at once; an evaluation only once its agent is built and the builds that can
+run leave a core free (``releasable``): Ray shares the cores fairly between kinds of task, so
+evaluations submitted early would delay the trainings that the sweep's end waits for. A task
 whose worker dies is run again (``cluster.MAX_RETRIES``). Each finished episode is kept at once
 (``episode_snapshots``), so an interrupted sweep resumes; once a setting's seeds are all in, its
 record (``run.assemble_record``, as ``softbench run`` makes it) is saved (``saving.save``) and
@@ -16,6 +19,8 @@ driver's, taken at the start, with the device the workers trained on.
 
 import pathlib
 import time
+from collections.abc import Callable
+from collections.abc import Iterable
 
 import ray
 
@@ -43,22 +48,25 @@ def _failure(error: ray.exceptions.RayError) -> str:
   return f"{type(cause).__name__}: {first_line(cause)}"
 
 
-def _submit(
+def _build_cores(build: grid.Build) -> int:
+  return cluster.collection_cores() if build.kind == "dataset" else 1
+
+
+def _submit_builds(
   plan: grid.Plan, states: relay.Relay | None
-) -> dict[ray.ObjectRef, grid.Build | grid.Evaluation]:
-  """Submits every task of ``plan``, each given the refs of the builds it needs (a shipped one's
+) -> tuple[dict[grid.Build, ray.ObjectRef], dict[ray.ObjectRef, grid.Build]]:
+  """Submits every build of ``plan``, each given the refs of the builds it needs (a shipped one's
   put in the object store) and the relay its bars send their states to (``states``, if any);
-  the work of each task's ref, builds first."""
+  each build's ref, and the build of each submitted ref."""
   environment = cluster.runtime_env()
   refs, work = {}, {}
   for build in plan.builds:
     if build in plan.found:
       refs[build] = ray.put(shipping.read(build.files))
       continue
-    cores = cluster.collection_cores() if build.kind == "dataset" else 1
     refs[build] = _BUILD.options(
       name=build.label,
-      num_cpus=cores,
+      num_cpus=_build_cores(build),
       max_retries=cluster.MAX_RETRIES,
       runtime_env=environment,
     ).remote(
@@ -69,16 +77,43 @@ def _submit(
       states=states,
     )
     work[refs[build]] = build
-  for evaluation in plan.evaluations:
-    needed = () if evaluation.agent is None else (refs[evaluation.agent],)
-    ref = _EVALUATE.options(
-      name=evaluation.label,
-      num_cpus=1,
-      max_retries=cluster.MAX_RETRIES,
-      runtime_env=environment,
-    ).remote(evaluation.run, evaluation.seed, *needed, states=states)
-    work[ref] = evaluation
-  return work
+  return refs, work
+
+
+def _submit_evaluation(
+  evaluation: grid.Evaluation, refs: dict[grid.Build, ray.ObjectRef], states: relay.Relay | None
+) -> ray.ObjectRef:
+  needed = () if evaluation.agent is None else (refs[evaluation.agent],)
+  return _EVALUATE.options(
+    name=evaluation.label,
+    num_cpus=1,
+    max_retries=cluster.MAX_RETRIES,
+    runtime_env=cluster.runtime_env(),
+  ).remote(evaluation.run, evaluation.seed, *needed, states=states)
+
+
+def releasable(
+  held: list[grid.Evaluation],
+  builds: Iterable[grid.Build],
+  finished: set,
+  cores: int,
+  build_cores: Callable[[grid.Build], int] = _build_cores,
+) -> list[grid.Evaluation]:
+  """The ``held`` evaluations to submit now: none while the unfinished ``builds`` whose needs are
+  all ``finished`` ask for every one of the ``cores``; else those whose agent is finished (or
+  that need none)."""
+  runnable = [
+    build
+    for build in builds
+    if build not in finished and all(need in finished for need in build.needs)
+  ]
+  if sum(build_cores(build) for build in runnable) >= cores:
+    return []
+  return [
+    evaluation
+    for evaluation in held
+    if evaluation.agent is None or evaluation.agent in finished
+  ]
 
 
 def execute(
@@ -115,14 +150,20 @@ def execute(
     written.append(files[0])
 
   states = relay.Relay() if show_progress else None  # The workers' bars, if shown.
-  work = _submit(plan, states)
+  refs, work = _submit_builds(plan, states)
+  builds, held = list(work.values()), list(plan.evaluations)
   pending, finished, failed = list(work), set(plan.found), 0
   cores = cluster.cores()
   try:
-    with display.Display(len(work), len(plan.settings), show_progress) as shown:
+    with display.Display(len(work) + len(held), len(plan.settings), show_progress) as shown:
       for run in plan.settings:  # Those whose every seed was kept.
         complete(run)
-      while pending:
+      while pending or held:
+        for evaluation in releasable(held, builds, finished, cores):
+          held.remove(evaluation)
+          ref = _submit_evaluation(evaluation, refs, states)
+          work[ref] = evaluation
+          pending.append(ref)
         ready, pending = ray.wait(pending, num_returns=len(pending), timeout=_POLL_SECONDS)
         for ref in ready:  # In submission order: a build before the evaluations it feeds.
           task = work[ref]
