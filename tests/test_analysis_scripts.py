@@ -329,9 +329,14 @@ def test_sweep_vs_loop_counts_an_interrupted_stretch_and_passes_the_interruption
     f"except KeyboardInterrupt:\n  pathlib.Path({str(saved)!r}).touch(); raise SystemExit(130)",
   ]
   main = threading.get_ident()
-  threading.Timer(2.0, signal.pthread_kill, (main, signal.SIGINT)).start()
-  with pytest.raises(KeyboardInterrupt):
-    timing._timed(command, tmp_path, "sleeper")
+  # Ctrl-C's handler, also where the tests were started in the background (SIGINT ignored).
+  previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+  try:
+    threading.Timer(2.0, signal.pthread_kill, (main, signal.SIGINT)).start()
+    with pytest.raises(KeyboardInterrupt):
+      timing._timed(command, tmp_path, "sleeper")
+  finally:
+    signal.signal(signal.SIGINT, previous)
   (stretch,) = [json.loads(line) for line in (tmp_path / "times.jsonl").read_text().splitlines()]
   assert stretch["interrupted"] and stretch["returncode"] == 130 and saved.exists()
   assert 1.5 < stretch["seconds"] < 30

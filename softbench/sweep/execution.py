@@ -17,10 +17,10 @@ A record's wall time is the sweep's, from its start to that record; its provenan
 driver's, taken at the start, with the device the workers trained on.
 """
 
-import pathlib
-import time
 from collections.abc import Callable
 from collections.abc import Iterable
+import pathlib
+import time
 
 import ray
 
@@ -110,9 +110,7 @@ def releasable(
   if sum(build_cores(build) for build in runnable) >= cores:
     return []
   return [
-    evaluation
-    for evaluation in held
-    if evaluation.agent is None or evaluation.agent in finished
+    evaluation for evaluation in held if evaluation.agent is None or evaluation.agent in finished
   ]
 
 
