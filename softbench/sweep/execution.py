@@ -81,14 +81,17 @@ def _submit_builds(
 
 
 def _submit_evaluation(
-  evaluation: grid.Evaluation, refs: dict[grid.Build, ray.ObjectRef], states: relay.Relay | None
+  evaluation: grid.Evaluation,
+  refs: dict[grid.Build, ray.ObjectRef],
+  states: relay.Relay | None,
+  environment: dict,
 ) -> ray.ObjectRef:
   needed = () if evaluation.agent is None else (refs[evaluation.agent],)
   return _EVALUATE.options(
     name=evaluation.label,
     num_cpus=1,
     max_retries=cluster.MAX_RETRIES,
-    runtime_env=cluster.runtime_env(),
+    runtime_env=environment,
   ).remote(evaluation.run, evaluation.seed, *needed, states=states)
 
 
@@ -102,16 +105,10 @@ def releasable(
   """The ``held`` evaluations to submit now: none while the unfinished ``builds`` whose needs are
   all ``finished`` ask for every one of the ``cores``; else those whose agent is finished (or
   that need none)."""
-  runnable = [
-    build
-    for build in builds
-    if build not in finished and all(need in finished for need in build.needs)
-  ]
+  runnable = [build for build in builds if build not in finished and _ready(build, finished)]
   if sum(build_cores(build) for build in runnable) >= cores:
     return []
-  return [
-    evaluation for evaluation in held if evaluation.agent is None or evaluation.agent in finished
-  ]
+  return [evaluation for evaluation in held if _ready(evaluation, finished)]
 
 
 def execute(
@@ -149,6 +146,7 @@ def execute(
 
   states = relay.Relay() if show_progress else None  # The workers' bars, if shown.
   refs, work = _submit_builds(plan, states)
+  environment = cluster.runtime_env()
   builds, held = list(work.values()), list(plan.evaluations)
   pending, finished, failed = list(work), set(plan.found), 0
   cores = cluster.cores()
@@ -157,9 +155,10 @@ def execute(
       for run in plan.settings:  # Those whose every seed was kept.
         complete(run)
       while pending or held:
-        for evaluation in releasable(held, builds, finished, cores):
-          held.remove(evaluation)
-          ref = _submit_evaluation(evaluation, refs, states)
+        released = releasable(held, builds, finished, cores)
+        held = [evaluation for evaluation in held if evaluation not in released]
+        for evaluation in released:
+          ref = _submit_evaluation(evaluation, refs, states, environment)
           work[ref] = evaluation
           pending.append(ref)
         ready, pending = ray.wait(pending, num_returns=len(pending), timeout=_POLL_SECONDS)
@@ -182,7 +181,7 @@ def execute(
               episode_snapshots.save(task.run, task.seed, value[1])
             outcomes[task.run][task.seed] = value
             complete(task.run)
-        running = sum(all(need in finished for need in _needs(work[ref])) for ref in pending)
+        running = sum(_ready(work[ref], finished) for ref in pending)
         shown.update(len(finished) - len(plan.found), min(running, cores), failed, len(written))
         if states is not None:  # A finished task's last states came before its result.
           shown.show_workers(states.take())
@@ -200,3 +199,8 @@ def _needs(task: grid.Build | grid.Evaluation) -> tuple[grid.Build, ...]:
   if isinstance(task, grid.Build):
     return task.needs
   return () if task.agent is None else (task.agent,)
+
+
+def _ready(task: grid.Build | grid.Evaluation, finished: set) -> bool:
+  """Whether every build ``task`` needs is ``finished``."""
+  return all(need in finished for need in _needs(task))
