@@ -19,6 +19,7 @@ ONE_OFF_TABLE_HEADERS = (
   "| helpers |",  # docs/paper-comparison.md: reach with the other helper convention.
   "| robot, fault |",  # docs/faults.md: records of the fault experiment, in docs/faults/.
   "| stage |",  # docs/adaptive-activation.md: adaptive activation per stage.
+  "| CPU |",  # docs/paper-comparison.md: SAC on two kinds of CPU (docs/analysis/sweep_vs_loop/sac).
 )
 EXP1S_RECORD = "smpl-exp1s-default-2026-11-24T041101Z.json"
 
