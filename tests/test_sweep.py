@@ -385,7 +385,7 @@ def test_evaluations_wait_while_the_runnable_builds_fill_every_core(tmp_path):
   assert len(agents) == 3 and len(baselines) == 3
 
   def released(finished: set, cores: int) -> list:
-    return execution.releasable(held, plan.builds, finished, cores, build_cores=lambda build: 1)
+    return execution.releasable(held, plan.builds, finished, cores, dict.fromkeys(plan.builds, 1))
 
   assert released(set(), cores=1) == []  # The dataset's collection fills the only core.
   assert released(set(), cores=2) == baselines  # It leaves one: those that need no agent.

@@ -17,8 +17,8 @@ A record's wall time is the sweep's, from its start to that record; its provenan
 driver's, taken at the start, with the device the workers trained on.
 """
 
-from collections.abc import Callable
 from collections.abc import Iterable
+from collections.abc import Mapping
 import pathlib
 import time
 
@@ -48,16 +48,22 @@ def _failure(error: ray.exceptions.RayError) -> str:
   return f"{type(cause).__name__}: {first_line(cause)}"
 
 
-def _build_cores(build: grid.Build) -> int:
-  return cluster.collection_cores() if build.kind == "dataset" else 1
+def _build_cores(plan: grid.Plan) -> dict[grid.Build, int]:
+  """The cores each build of ``plan`` to run asks for (the cluster asked once)."""
+  collection = cluster.collection_cores()
+  return {
+    build: collection if build.kind == "dataset" else 1
+    for build in plan.builds
+    if build not in plan.found
+  }
 
 
 def _submit_builds(
-  plan: grid.Plan, states: relay.Relay | None
+  plan: grid.Plan, build_cores: Mapping[grid.Build, int], states: relay.Relay | None
 ) -> tuple[dict[grid.Build, ray.ObjectRef], dict[ray.ObjectRef, grid.Build]]:
-  """Submits every build of ``plan``, each given the refs of the builds it needs (a shipped one's
-  put in the object store) and the relay its bars send their states to (``states``, if any);
-  each build's ref, and the build of each submitted ref."""
+  """Submits every build of ``plan``, each asking for its ``build_cores`` and given the refs of
+  the builds it needs (a shipped one's put in the object store) and the relay its bars send their
+  states to (``states``, if any); each build's ref, and the build of each submitted ref."""
   environment = cluster.runtime_env()
   refs, work = {}, {}
   for build in plan.builds:
@@ -66,7 +72,7 @@ def _submit_builds(
       continue
     refs[build] = _BUILD.options(
       name=build.label,
-      num_cpus=_build_cores(build),
+      num_cpus=build_cores[build],
       max_retries=cluster.MAX_RETRIES,
       runtime_env=environment,
     ).remote(
@@ -100,13 +106,13 @@ def releasable(
   builds: Iterable[grid.Build],
   finished: set,
   cores: int,
-  build_cores: Callable[[grid.Build], int] = _build_cores,
+  build_cores: Mapping[grid.Build, int],
 ) -> list[grid.Evaluation]:
   """The ``held`` evaluations to submit now: none while the unfinished ``builds`` whose needs are
   all ``finished`` ask for every one of the ``cores``; else those whose agent is finished (or
   that need none)."""
   runnable = [build for build in builds if build not in finished and _ready(build, finished)]
-  if sum(build_cores(build) for build in runnable) >= cores:
+  if sum(build_cores[build] for build in runnable) >= cores:
     return []
   return [evaluation for evaluation in held if _ready(evaluation, finished)]
 
@@ -145,7 +151,8 @@ def execute(
     written.append(files[0])
 
   states = relay.Relay() if show_progress else None  # The workers' bars, if shown.
-  refs, work = _submit_builds(plan, states)
+  build_cores = _build_cores(plan)
+  refs, work = _submit_builds(plan, build_cores, states)
   environment = cluster.runtime_env()
   builds, held = list(work.values()), list(plan.evaluations)
   pending, finished, failed = list(work), set(plan.found), 0
@@ -155,7 +162,7 @@ def execute(
       for run in plan.settings:  # Those whose every seed was kept.
         complete(run)
       while pending or held:
-        released = releasable(held, builds, finished, cores)
+        released = releasable(held, builds, finished, cores, build_cores)
         held = [evaluation for evaluation in held if evaluation not in released]
         for evaluation in released:
           ref = _submit_evaluation(evaluation, refs, states, environment)
