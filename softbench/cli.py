@@ -329,7 +329,7 @@ def _zoo_add(args: argparse.Namespace) -> None:
   from softbench.zoo import listing as zoo_listing
 
   chosen = zoo_catalogue.requested_setting(
-    args.agent, args.robot, args.protocol, args.family, args.profile, args.seeds
+    args.agent, args.robot, args.protocol, args.family, args.profile, args.seeds, args.seed
   )
   folder = zoo.chosen_folder(args.zoo, create=True)
   added, skipped, unchecked = zoo_catalogue.add(
@@ -344,7 +344,7 @@ def _zoo_remove(args: argparse.Namespace) -> None:
   from softbench.zoo import listing as zoo_listing
 
   chosen = zoo_catalogue.requested_setting(
-    args.agent, args.robot, args.protocol, args.family, args.profile, args.seeds
+    args.agent, args.robot, args.protocol, args.family, args.profile, args.seeds, args.seed
   )
   folder = zoo.chosen_folder(args.zoo)
   print(zoo_listing.removals(zoo_catalogue.remove(chosen, folder), folder))
@@ -675,6 +675,14 @@ def _add_zoo_setting_arguments(parser: argparse.ArgumentParser) -> None:
     help=f"with --protocol {exp1s_records.PROTOCOL}: one of {', '.join(robots.TENDON_FAMILIES)}",
   )
   parser.add_argument("--seeds", type=int, help="seeds 0 .. N-1 (default: the profile's)")
+  parser.add_argument(
+    "--seed",
+    type=int,
+    action="append",
+    default=[],
+    help="seed K alone instead (repeat for several): e.g. to carry some trainings under way "
+    "within the zoo's budget",
+  )
   _add_profile_argument(parser)
 
 

@@ -240,6 +240,34 @@ def test_removing_an_agent_keeps_the_forward_models_that_another_agent_in_the_zo
   assert [path.name for path in folder.rglob("*")] == [zoo.MANIFEST]
 
 
+def test_zoo_add_and_remove_take_the_seeds_named_with_seed_alone(
+  run_wide_homes, tmp_path, monkeypatch
+):
+  # Seeds 0 and 1 trained in the run's home of ROBOT; `--seed K` adds or removes seed K's files
+  # (checkpoint and forward models) and leaves the other seed's where they were.
+  home = run_wide_homes(ROBOT)
+  use(monkeypatch, home)
+  for seed in (0, 1):
+    agents.make("lstm", ROBOT, seed, "tiny")
+
+  def files_of(seed):
+    chosen = catalogue.setting("lstm", ROBOT, None, "tiny", None, [seed])
+    assert chosen.seeds == (seed,)
+    return {path.relative_to(home).as_posix() for _, path, _ in catalogue.cache_files(chosen)}
+
+  (tmp_path / "results").mkdir()
+  argv = ["--agent", "lstm", "--robot", ROBOT, "--profile", "tiny", "--zoo", str(tmp_path / "zoo")]
+  add = ["zoo", "add", *argv, "--results", str(tmp_path / "results")]
+  assert files_of(0) and not files_of(0) & files_of(1)
+  assert cli.main([*add, "--seed", "1"]) == 0
+  assert set(zoo.read_manifest(tmp_path / "zoo")) == files_of(1)
+  assert cli.main([*add, "--seed", "1", "--seed", "0", "--seed", "1"]) == 0
+  assert set(zoo.read_manifest(tmp_path / "zoo")) == files_of(0) | files_of(1)
+  assert cli.main(["zoo", "remove", *argv, "--seed", "0"]) == 0
+  assert set(zoo.read_manifest(tmp_path / "zoo")) == files_of(1)
+  assert zoo.check_files(tmp_path / "zoo") == []
+
+
 def run_command(results, seeds=2):
   return [
     "run",
@@ -421,6 +449,8 @@ def test_a_record_naming_weights_of_a_seed_it_lacks_is_refused(babbled, tmp_path
     (["--protocol", "exp2s"], "unknown protocol"),
     (["--family", "tendon-local"], "--family goes with --protocol"),
     (["--agent", "lstm", "--robot", ROBOT, "--seeds", "0"], "at least 1"),
+    (["--agent", "lstm", "--robot", ROBOT, "--seed", "-1"], "at least 0"),
+    (["--agent", "lstm", "--robot", ROBOT, "--seeds", "2", "--seed", "1"], "exclude each other"),
     (["--agent", "lstm", "--robot", ROBOT], "nothing of"),  # Trained (add), in the zoo (remove).
   ],
 )

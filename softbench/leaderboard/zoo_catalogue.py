@@ -2,6 +2,7 @@
 networks), the committed records each of them stands behind (those whose ``weights`` section
 names these files' sha256), and adding them to the zoo or removing them."""
 
+from collections.abc import Sequence
 import dataclasses
 import pathlib
 
@@ -19,10 +20,10 @@ from softbench.records import fields as record_fields
 @dataclasses.dataclass(frozen=True)
 class Setting:
   """A learned agent on a robot (``agent`` and ``robot``), or Exp1S on a tendon family
-  (``family``), at a profile, for seeds 0 .. seeds-1."""
+  (``family``), at a profile, for the seeds ``seeds`` (ascending)."""
 
   profile: profiles.Profile
-  seeds: int
+  seeds: tuple[int, ...]
   agent: str | None = None
   robot: str | None = None
   family: str | None = None
@@ -37,18 +38,23 @@ class Setting:
 
 
 def setting(
-  agent: str | None, robot: str | None, family: str | None, profile: str, seeds: int | None
+  agent: str | None,
+  robot: str | None,
+  family: str | None,
+  profile: str,
+  seeds: int | None,
+  only_seeds: Sequence[int] = (),
 ) -> Setting:
-  """A checked ``Setting``: ``agent`` (learned) with ``robot``, or ``family`` alone.
+  """A checked ``Setting``: ``agent`` (learned) with ``robot``, or ``family`` alone, for seeds
+  0 .. ``seeds``-1 (default: the profile's), or for the seeds ``only_seeds`` alone.
 
   Raises:
     ValueError: a missing or extra name, an agent that does not learn, an unknown robot, family
-      or profile, or seeds < 1 (one line).
+      or profile, seeds < 1, a negative seed in ``only_seeds``, or both ``seeds`` and
+      ``only_seeds`` (one line).
   """
   chosen = profiles.get(profile)
-  seeds = chosen.seeds if seeds is None else seeds
-  if seeds < 1:
-    raise ValueError(f"seeds must be at least 1, got {seeds}")
+  seeds = chosen_seeds(chosen, seeds, only_seeds)
   if family is not None:
     if agent not in (None, "smpl") or robot is not None:
       raise ValueError(
@@ -70,6 +76,27 @@ def setting(
   return Setting(chosen, seeds, agent=agent, robot=robot)
 
 
+def chosen_seeds(
+  profile: profiles.Profile, seeds: int | None, only_seeds: Sequence[int]
+) -> tuple[int, ...]:
+  """Seeds 0 .. ``seeds``-1 (default: ``profile``'s number), or ``only_seeds`` (each once,
+  ascending), for ``zoo add`` and ``zoo remove``'s ``--seeds N`` and repeatable ``--seed K``.
+
+  Raises:
+    ValueError: both given, seeds < 1 or a negative seed (one line).
+  """
+  if only_seeds:
+    if seeds is not None:
+      raise ValueError("--seeds N (seeds 0 .. N-1) and --seed K (seed K alone) exclude each other")
+    if min(only_seeds) < 0:
+      raise ValueError(f"a seed is at least 0, got {min(only_seeds)}")
+    return tuple(sorted(set(only_seeds)))
+  seeds = profile.seeds if seeds is None else seeds
+  if seeds < 1:
+    raise ValueError(f"seeds must be at least 1, got {seeds}")
+  return tuple(range(seeds))
+
+
 def requested_setting(
   agent: str | None,
   robot: str | None,
@@ -77,6 +104,7 @@ def requested_setting(
   family: str | None,
   profile: str,
   seeds: int | None,
+  only_seeds: Sequence[int] = (),
 ) -> Setting:
   """The ``setting`` that ``softbench zoo add`` names: ``agent`` on ``robot``, or ``protocol``
   (Exp1S) on ``family`` (default ``continual.DEFAULT_FAMILY``).
@@ -91,7 +119,7 @@ def requested_setting(
     family = family or continual.DEFAULT_FAMILY
   elif family is not None:
     raise ValueError(f"--family goes with --protocol {continual.PROTOCOL}")
-  return setting(agent, robot, family, profile, seeds)
+  return setting(agent, robot, family, profile, seeds, only_seeds)
 
 
 def cache_files(chosen: Setting) -> list[tuple[int, pathlib.Path, str]]:
@@ -100,12 +128,12 @@ def cache_files(chosen: Setting) -> list[tuple[int, pathlib.Path, str]]:
   if chosen.family is not None:
     return [
       (seed, continual.checkpoint_path(seed, chosen.profile, chosen.family), "agent")
-      for seed in range(chosen.seeds)
+      for seed in chosen.seeds
     ]
   learner, arm = agents.learner(chosen.agent), robots.make(chosen.robot)
   return [
     (seed, path, kind)
-    for seed in range(chosen.seeds)
+    for seed in chosen.seeds
     for path, kind in learned.cache_files(
       chosen.agent, arm, seed, chosen.profile, learner.per_module
     )
@@ -160,7 +188,7 @@ def records_of(chosen: Setting, results: pathlib.Path, link_unchecked: bool = Fa
   for seed, path, _ in cache_files(chosen):
     files_of_seed.setdefault(seed, []).append(path)
   linked, unchecked = {}, set()
-  for seed in range(chosen.seeds):
+  for seed in chosen.seeds:
     (hashes,) = zoo.weights([files_of_seed[seed]])
     linked[seed] = []
     for path, record in found:
