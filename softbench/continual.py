@@ -19,7 +19,6 @@ every later stage. A changed score would be forgetting, and raises.
 
 from collections.abc import Sequence
 import dataclasses
-import hashlib
 import pathlib
 import sys
 import time
@@ -167,7 +166,7 @@ class Exp1sModel:
 def _config(seed: int, profile: profiles.Profile, arms: list) -> Exp1sConfig:
   return Exp1sConfig(
     tuple(arm.name for arm in arms),
-    tuple(hashlib.sha256(arm.to_xml().encode()).hexdigest() for arm in arms),
+    tuple(arm.physics_sha256() for arm in arms),
     profile.samples,
     seed,
     profile.max_epochs,

@@ -7,6 +7,7 @@ from softbench import continual
 from softbench import metrics
 from softbench import profiles
 from softbench import robots
+from softbench.robots import versions
 
 ROBOTS = tuple(f"tendon-{n}" for n in range(1, 6))
 DATE = "2026-01-02T03:04:05+00:00"
@@ -59,6 +60,7 @@ def exp1s_record(
     "git_commit": None,
     "date": date,
     "machine": {"platform": "test"},
+    "physics": versions.current().name,  # As softbench run stamps its records here.
     "protocol": continual.PROTOCOL,
     "agent": "smpl",
     "robots": list(robot_names),

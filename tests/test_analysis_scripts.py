@@ -19,6 +19,7 @@ from softbench import run
 from softbench.agents import hyperparameters
 from softbench.agents import learned
 from softbench.agents import learners
+from softbench.robots import versions
 
 ANALYSIS = pathlib.Path(__file__).parent.parent / "docs" / "analysis"
 
@@ -340,3 +341,18 @@ def test_sweep_vs_loop_counts_an_interrupted_stretch_and_passes_the_interruption
   (stretch,) = [json.loads(line) for line in (tmp_path / "times.jsonl").read_text().splitlines()]
   assert stretch["interrupted"] and stretch["returncode"] == 130 and saved.exists()
   assert 1.5 < stretch["seconds"] < 30
+
+
+def test_stack_speed_measures_each_stack_in_a_fresh_process(monkeypatch, capsys):
+  # Both "stacks" are this interpreter here; CI's machines have one stack each.
+  out = run_script(
+    "stack_speed",
+    ["--robots", "tendon-1", "--rounds", "1", "--v0", sys.executable, "--v1", sys.executable],
+    monkeypatch,
+    capsys,
+  )
+  (row,) = re.findall(
+    r"^\| tendon-1 \| ([\d,]+) \(([\d.]+)\) \| ([\d,]+) \(([\d.]+)\) \| ([\d.]+) \|$", out, re.M
+  )
+  assert all(float(value.replace(",", "")) > 0 for value in row)
+  assert f"MuJoCo {versions.engine_version()}" in out

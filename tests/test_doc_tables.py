@@ -10,7 +10,9 @@ import pytest
 
 from softbench import cli
 from softbench import leaderboard
+from softbench import records
 from softbench.leaderboard import doc_tables
+from softbench.records import fields as record_fields
 
 ROOT = pathlib.Path(__file__).parent.parent
 RESULTS = ROOT / "leaderboard" / "results"
@@ -52,7 +54,11 @@ def test_every_block_is_known_and_equals_what_the_records_give(pages, board):
 
 
 def test_every_named_table_appears_in_the_docs(pages):
-  shown = {block.name for text in pages.values() for block in doc_tables.blocks(text)}
+  shown = {
+    block.name.partition(doc_tables.PHYSICS_SEPARATOR)[0]
+    for text in pages.values()
+    for block in doc_tables.blocks(text)
+  }
   assert shown == set(doc_tables.TABLES)
 
 
@@ -77,6 +83,17 @@ def test_an_unknown_table_fails(board):
     doc_tables.blocks("text\n" + _block("no-such"), "README.md")
   with pytest.raises(doc_tables.DocTableError, match="unknown table"):
     doc_tables.render("no-such", board)
+  with pytest.raises(doc_tables.DocTableError, match="README.md:2: unknown physics version 'v9'"):
+    doc_tables.blocks("text\n" + _block("headline-spiral@v9"), "README.md")
+
+
+def test_a_block_names_the_physics_of_its_records(board):
+  # NAME@v0 is the table of the v0 records, which every committed record before 2026-12-07 is.
+  committed = records.read_folder(RESULTS)
+  v0 = leaderboard.ranking.rank(
+    [(path, record) for path, record in committed if record_fields.physics_of(record) == "v0"]
+  )
+  assert doc_tables.render("headline-spiral@v0", board) == doc_tables.render("headline-spiral", v0)
 
 
 @pytest.mark.parametrize(
@@ -94,13 +111,13 @@ def test_a_malformed_block_fails(text, message):
 
 def test_an_out_of_date_block_fails_and_rewriting_mends_it(pages, board):
   readme = pages[ROOT / "README.md"]
-  generated = doc_tables.render("headline-spiral", board)
+  generated = doc_tables.render("headline-spiral@v0", board)
   edited = readme.replace(generated, generated.replace("6.69 ± 1.77", "6.68 ± 1.77"), 1)
   assert edited != readme
-  assert doc_tables.stale_blocks(edited, board) == ["headline-spiral"]
+  assert doc_tables.stale_blocks(edited, board) == ["headline-spiral@v0"]
   assert doc_tables.rewrite(edited, board) == readme
   emptied = readme.replace(generated, "", 1)
-  assert doc_tables.stale_blocks(emptied, board) == ["headline-spiral"]
+  assert doc_tables.stale_blocks(emptied, board) == ["headline-spiral@v0"]
   assert doc_tables.rewrite(emptied, board) == readme
 
 

@@ -21,7 +21,10 @@ from softbench import suite
 import softbench.envs
 from softbench.envs import environment
 from softbench.robots import faults
+from softbench.robots import versions
 from softbench.suite import references
+
+ID_VERSION = f"v{softbench.envs.VERSION}"  # The installed physics version, which ids end in.
 
 SHORT_STEPS = 3  # Control steps of every shortened episode (as in test_suite: shared references).
 
@@ -168,20 +171,31 @@ def test_rgb_array_frames_show_the_arm_headlessly(robot):
 @pytest.mark.parametrize(
   "make_env,message",
   [
-    (lambda: gymnasium.make("softbench/tendon-3-spiral-v0", lenght=3), "no option 'lenght'"),
-    (lambda: gymnasium.make("softbench/tendon-3-custom-v0"), "needs a trajectory"),
-    (lambda: gymnasium.make("softbench/tendon-3-reach-v0", module=4), "module must be 1 to 3"),
     (
-      lambda: gymnasium.make("softbench/tendon-3-reach-v0", observation="image"),
+      lambda: gymnasium.make(f"softbench/tendon-3-spiral-{ID_VERSION}", lenght=3),
+      "no option 'lenght'",
+    ),
+    (lambda: gymnasium.make(f"softbench/tendon-3-custom-{ID_VERSION}"), "needs a trajectory"),
+    (
+      lambda: gymnasium.make(f"softbench/tendon-3-reach-{ID_VERSION}", module=4),
+      "module must be 1 to 3",
+    ),
+    (
+      lambda: gymnasium.make(f"softbench/tendon-3-reach-{ID_VERSION}", observation="image"),
       "observation must be one of flat, dict",
     ),
     (
       lambda: environment.SoftArmEnv("tendon-3", "reach", render_mode="ansi"),
       "render_mode must be None or one of rgb_array",
     ),
-    (lambda: gymnasium.make("softbench/tendon-3-reach-v0", width=64), "need render_mode"),
     (
-      lambda: gymnasium.make("softbench/tendon-3-reach-v0", render_mode="rgb_array", width=7),
+      lambda: gymnasium.make(f"softbench/tendon-3-reach-{ID_VERSION}", width=64),
+      "need render_mode",
+    ),
+    (
+      lambda: gymnasium.make(
+        f"softbench/tendon-3-reach-{ID_VERSION}", render_mode="rgb_array", width=7
+      ),
       "width must be an even number",
     ),
     (
@@ -229,8 +243,17 @@ def test_the_physics_side_and_the_environments_import_without_torch():
 
 def test_a_make_without_importing_softbench_uses_the_module_form():
   code = (
-    "import gymnasium; env = gymnasium.make('softbench.envs:softbench/tendon-1-reach-v0', "
-    "steps=1); print(env.reset(seed=0)[0].shape)"
+    "import gymnasium; env = gymnasium.make("
+    f"'softbench.envs:softbench/tendon-1-reach-{ID_VERSION}', steps=1); "
+    "print(env.reset(seed=0)[0].shape)"
   )
   result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
   assert result.stdout.strip() == "(11,)"  # tendon-1: one pose (6), the point (3), 2 cables.
+
+
+def test_ids_end_in_the_installed_physics_version():
+  assert ID_VERSION == versions.current().name
+  assert all(env_id.endswith(f"-{ID_VERSION}") for env_id in softbench.envs.env_ids())
+  other = next(name for name in versions.VERSIONS if name != ID_VERSION)
+  with pytest.raises(gymnasium.error.Error, match=ID_VERSION):  # Gymnasium names the one there is.
+    gymnasium.make(f"softbench/tendon-3-spiral-{other}")

@@ -538,3 +538,38 @@ def test_write_on_a_missing_or_empty_folder(make_folder, tmp_path, capsys):
   assert ("an empty folder" if make_folder else "no folder") in printed
   for page in ("README.md", "index.html"):
     assert "No result records yet" in (out / page).read_text()
+
+
+# Physics versions: never ranked together.
+
+
+def test_records_of_two_physics_versions_are_ranked_apart(real_record, tmp_path, capsys):
+  results = tmp_path / "results"
+  results.mkdir()
+  newer = variant(real_record, physics="v1", date="2026-12-07T00:00:00+00:00")
+  older = variant(real_record, agent="random", scale=0.5, physics=None)  # Before versions: v0.
+  for name, record in (("newer", newer), ("older", older)):
+    records.write(record, results / f"{name}.json")
+  board = leaderboard.build(results)
+  assert board.physics == "v1" and [e.record["agent"] for e in board.groups[0].entries] == ["zero"]
+  (earlier,) = board.earlier
+  assert earlier.physics == "v0" and [e.record["agent"] for e in earlier.groups[0].entries] == [
+    "random"
+  ]  # The better v0 record is not ranked above the v1 one.
+  assert board.of_physics("v0") is earlier and board.of_physics("v1") is board
+  site = tmp_path / "site"
+  leaderboard.write(board, results, site)
+  page = (site / "README.md").read_text()
+  assert "Current physics: physics v1" in page and "# Earlier physics: physics v0" in page
+  html = (site / "index.html").read_text()
+  assert 'id="physics-v0"' in html and "Earlier physics: physics v0" in html
+  rows = list(csv.DictReader((site / csv_table.FILE_NAME).open()))
+  assert [(row["physics"], row["agent"]) for row in rows] == [("v1", "zero"), ("v0", "random")]
+  assert cli.main(["leaderboard", "--results", str(results)]) == 0
+  assert "earlier physics: physics v0" in capsys.readouterr().out
+
+
+def test_a_record_of_an_unknown_physics_version_is_refused(real_record, tmp_path):
+  path = write_raw(variant(real_record) | {"physics": "v9"}, tmp_path / "x.json")
+  with pytest.raises(records.RecordError, match="physics"):
+    records.read(path)

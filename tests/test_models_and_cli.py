@@ -20,6 +20,7 @@ from softbench import storage
 from softbench import suite
 from softbench.agents import hyperparameters
 from softbench.robots import export
+from softbench.robots import versions
 from softbench.robots.physics import SoftArmPhysics
 
 MODELS = pathlib.Path(__file__).resolve().parents[1] / "models"
@@ -98,7 +99,7 @@ def test_cli_lists_robots_tasks_and_agents_as_json(capsys):
     assert (facts["modules"], facts["length_m"]) == (arm.num_modules, arm.length)
   assert cli.main(["robots", "tendon-7", "--json"]) == 0
   described = json.loads(capsys.readouterr().out)
-  assert described["modules"] == 7 and described["spec"]["backbone"] == "cable"
+  assert described["modules"] == 7 and described["spec"]["backbone"] == versions.current().backbone
   assert cli.main(["tasks", "--json"]) == 0
   tasks = json.loads(capsys.readouterr().out)
   assert [task["name"] for task in tasks] == list(suite.TASKS)

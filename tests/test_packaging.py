@@ -3,9 +3,11 @@ README's commands install with, the licence and citation files, and the version.
 
 import pathlib
 import re
+import subprocess
 
 from packaging import requirements
 from packaging import utils
+import pytest
 import tomllib
 
 import softbench
@@ -13,6 +15,11 @@ from softbench import cli
 
 ROOT = pathlib.Path(__file__).parent.parent
 PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())
+PYPROJECT_MUJOCO = next(
+  requirement.specifier
+  for requirement in map(requirements.Requirement, PYPROJECT["project"]["dependencies"])
+  if requirement.name == "mujoco"
+)
 
 
 def _pins() -> dict[str, str]:
@@ -49,10 +56,33 @@ def test_every_declared_dependency_is_pinned_within_its_range():
     assert requirement.specifier.contains(pins[name]), f"{name}=={pins[name]} not in {requirement}"
 
 
-def test_the_readme_commands_install_with_the_constraints():
+@pytest.mark.parametrize(
+  "stamp, constraints, mujoco",
+  [
+    (".venv/.installed", "constraints.txt", "4."),
+    (".venv-v0/.installed", "constraints-v0.txt", "3.17."),
+  ],
+)
+def test_each_stack_installs_with_its_constraints(stamp, constraints, mujoco):
+  # The current stack (physics v1) for make run and make test; the old one (v0) for make run-v0.
+  planned = subprocess.run(
+    ["make", "-n", "-B", stamp], cwd=ROOT, capture_output=True, text=True, check=True
+  ).stdout
+  venv = stamp.split("/")[0]
+  assert re.search(
+    rf"{re.escape(venv)}/bin/pip install [^\n]*-c {constraints} -e '\.\[test\]'", planned
+  )
+  pins = dict(
+    line.split("==")
+    for line in (ROOT / constraints).read_text().splitlines()
+    if "==" in line and not line.startswith("#")
+  )
+  assert pins["mujoco"].startswith(mujoco)
+  assert PYPROJECT_MUJOCO.contains(pins["mujoco"])
   makefile = (ROOT / "Makefile").read_text()
-  assert re.search(r"pip install [^\n]*-c constraints\.txt -e '\.\[test\]'", makefile)
-  assert re.search(r"^\$\(STAMP\): pyproject\.toml constraints\.txt$", makefile, re.M)
+  assert re.search(
+    rf"^\$\(STAMP{'_V0' if 'v0' in venv else ''}\): pyproject\.toml {constraints}$", makefile, re.M
+  )
 
 
 def test_licence_citation_and_version_agree():

@@ -22,7 +22,9 @@ from softbench.robots import make
 from softbench.robots import measure
 from softbench.robots import pneumatic
 from softbench.robots import tendon_family
+from softbench.robots import versions
 from softbench.robots.physics import SoftArmPhysics
+from softbench.robots.tendon import BACKBONES as TENDON_BACKBONES
 
 # Object kind (the MjModel accessor) and the MjModel attribute that counts them.
 NAMED_OBJECTS = {
@@ -60,9 +62,6 @@ BEND_LEVELS = (0.2, 0.4, 0.6, 0.8, 1.0)
 # modules' tips turn by 0.0 deg on every tendon-local arm (exactly: no load reaches them), and by
 # 30.6 deg or more on every tendon-N arm (tendon-3, module 3: 30.6 and 61.2 deg).
 PROXIMAL_TILT_DEG = {"tendon": (10.0, math.inf), "tendon-local": (0.0, 1.0)}
-# tendon-1 and tendon-3 reach equilibrium (max |qvel| < 1e-13) in 3 s for every action below.
-BACKBONE_SETTLE_S = 4.0
-BACKBONE_TOLERANCE = 0.01  # Fraction of the arm length.
 
 
 def _expected_size(name: str) -> tuple[int, int]:
@@ -400,7 +399,10 @@ def test_every_tendon_arm_builds(family, num_modules):
   robot = make(f"{family}-{num_modules}")
   model = robot.compile()
   assert robot.num_modules == num_modules
-  assert model.nu == model.ntendon == 4 * num_modules
+  assert model.ntendon == 4 * num_modules
+  assert len(robot.actuator_maps()) == model.nu
+  cables = [a for a in range(model.nu) if model.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_TENDON]
+  assert cables == list(range(4 * num_modules))  # The cables first; the rod's torsion after.
   tip_sites = [f"module{k}_tip" for k in range(1, num_modules + 1)]
   assert [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, s) >= 0 for s in tip_sites] == (
     [True] * num_modules
@@ -408,31 +410,7 @@ def test_every_tendon_arm_builds(family, num_modules):
   assert robot.length == pytest.approx(0.05 * num_modules)
 
 
-# 7. Cable plugin vs ball-joint backbone.
-
-
-@pytest.mark.parametrize("robot_name", ["tendon-1", "tendon-3"])
-def test_cable_and_joint_backbones_agree(robot_name):
-  # Measured worst disagreement: tendon-1 1e-16 of the length (the two are identical for planar
-  # bending); tendon-3 0.224 % (0.34 mm), for the random actions that mix x and y across modules
-  # and so twist the rod (the ball joints' twist stiffness is E·I/l, the cable's G·J/l = 2/3 of
-  # that); single-module actuations agree to 1e-15.
-  cable = make(robot_name)
-  joints = make(robot_name, backbone="joints")
-  actions = _random_actions(cable, 4, seed=3, scale=0.5)
-  for module in range(1, cable.num_modules + 1):
-    for entry, value in ((0, 1.0), (1, -1.0)):
-      action = np.zeros(cable.action_dim)
-      action[cable.module_action_slices()[module - 1].start + entry] = value
-      actions.append(action)
-  rest = tips(new_physics(cable))
-  worst = 0.0
-  for action in actions:
-    cable_tips = tips(settle(cable, action, BACKBONE_SETTLE_S))
-    joint_tips = tips(settle(joints, action, BACKBONE_SETTLE_S))
-    assert np.linalg.norm(cable_tips[-1] - rest[-1]) > 0.05 * cable.length
-    worst = max(worst, np.linalg.norm(cable_tips - joint_tips, axis=1).max() / cable.length)
-  assert worst < BACKBONE_TOLERANCE, f"backbones disagree by {worst:.2%} of the length"
+# 7. The rod against the cable plugin and beam theory: tests/test_rod.py.
 
 
 # 7b. Discretisation: refining the chain must not change the module's material.
@@ -455,12 +433,40 @@ def _rod_segments(model: mujoco.MjModel, module: int) -> list[int]:
   return [b for b in range(model.nbody) if model.body(b).name.startswith(f"module{module}_segment")]
 
 
-# Every backbone the robots build: the cable plugin (tendon arms' default), ball-joint springs
-# (``backbone="joints"``) and the pneumatic arm's ball and slide springs.
+def _torsion_softening(model: mujoco.MjModel, module: int) -> dict[str, float]:
+  """Each of a module's joints' torsion actuator's bias (N·m/rad), by joint name."""
+  return {
+    model.joint(model.actuator_trnid[a][0]).name: float(model.actuator_biasprm[a][1])
+    for a in range(model.nu)
+    if model.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINTINPARENT
+    and model.joint(model.actuator_trnid[a][0]).name.startswith(f"module{module}_segment")
+  }
+
+
+def _module_twist_compliance(model: mujoco.MjModel, module: int) -> float:
+  """Sum of 1 / (twisting stiffness) over a module's ball joints: the ball spring less its torsion
+  actuator's softening; 0 where the cable plugin carries the elasticity."""
+  softening = _torsion_softening(model, module)
+  return float(
+    sum(
+      1.0 / (model.jnt_stiffness[j] - softening.get(model.joint(j).name, 0.0))
+      for j in range(model.njnt)
+      if model.joint(j).name.startswith(f"module{module}_segment")
+      and model.joint(j).name.endswith("_ball")
+      and model.jnt_stiffness[j] > 0
+    )
+  )
+
+
+# Every backbone the robots build: the tendon arms' rod (ball springs and torsion actuators) and,
+# where MuJoCo 3 is installed, their cable plugin; the pneumatic arm's ball and slide springs.
 _BACKBONES = [pytest.param(name, {}, id=name) for name in BENCHMARK_ROBOTS] + [
-  pytest.param(name, {"backbone": "joints"}, id=f"{name}-joints")
+  pytest.param(name, {"backbone": backbone}, id=f"{name}-{backbone}")
   for name in BENCHMARK_ROBOTS
   if name.startswith("tendon-")
+  for backbone in TENDON_BACKBONES
+  if backbone != versions.current().backbone
+  and (backbone != "cable" or versions.cable_plugin_available())
 ]
 
 
@@ -498,6 +504,9 @@ def test_refining_keeps_every_module_material(robot_name, overrides, factor):
       assert _module_series_compliance(fine, module, kind) == pytest.approx(
         _module_series_compliance(coarse, module, kind), rel=1e-5
       ), (module, kind)
+    assert _module_twist_compliance(fine, module) == pytest.approx(
+      _module_twist_compliance(coarse, module), rel=1e-5
+    ), module
 
 
 # 8. Exported XML.

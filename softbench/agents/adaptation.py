@@ -26,7 +26,6 @@ that names the healthy checkpoint and the faults, with the wall time of the retr
 
 import copy
 import dataclasses
-import hashlib
 import json
 import pathlib
 import time
@@ -142,7 +141,7 @@ def retrain_column(
   config = RetrainedConfig(
     learned.checkpoint_path("smpl", healthy, seed, profile, per_module=True).stem,
     tuple(sorted((f.module, f.actuator, f.gain) for f in faulty_robot.faults)),
-    hashlib.sha256(faulty_robot.to_xml().encode()).hexdigest(),
+    faulty_robot.physics_sha256(),
     module,
     forward_modules,
     profile.samples,

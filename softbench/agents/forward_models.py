@@ -13,7 +13,6 @@ interrupted training resumes from its snapshots (``smpl.snapshots``, in the cach
 """
 
 import dataclasses
-import hashlib
 import pathlib
 
 from smpl import checkpoint
@@ -64,7 +63,7 @@ def configs(
   training_version: int,
 ) -> list[ForwardModelConfig]:
   """The cache configs of ``views``' forward models trained with ``config`` (``prepare``)."""
-  xml_sha256 = hashlib.sha256(robot.to_xml().encode()).hexdigest()
+  xml_sha256 = robot.physics_sha256()
   return [
     ForwardModelConfig(
       robot.name,

@@ -37,7 +37,6 @@ those of the unmasked agent, bit for bit.
 """
 
 import dataclasses
-import hashlib
 import pathlib
 from typing import Callable
 
@@ -537,7 +536,7 @@ def trained_config(
   return TrainedConfig(
     name,
     robot.name,
-    hashlib.sha256(robot.to_xml().encode()).hexdigest(),
+    robot.physics_sha256(),
     tuple(view.name for view in views),
     profile.samples,
     seed,

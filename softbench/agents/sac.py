@@ -12,7 +12,6 @@ least every ``snapshots.SAVE_INTERVAL_S``) to the same weights as an uninterrupt
 """
 
 import dataclasses
-import hashlib
 import io
 import pathlib
 import random
@@ -105,7 +104,7 @@ def training_config(
 ) -> TrainingConfig:
   return TrainingConfig(
     robot.name,
-    hashlib.sha256(robot.to_xml().encode()).hexdigest(),
+    robot.physics_sha256(),
     profile.samples,
     seed,
     STEPS[profile.name],

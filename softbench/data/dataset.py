@@ -169,7 +169,7 @@ def generating_config(
   return {
     "format_version": FORMAT_VERSION,
     "robot": arm.name,
-    "robot_xml_sha256": hashlib.sha256(arm.to_xml().encode()).hexdigest(),
+    "robot_xml_sha256": arm.physics_sha256(),
     "mujoco_version": mujoco.__version__,
     "num_modules": arm.num_modules,
     "actuators_per_module": list(arm.actuators_per_module),

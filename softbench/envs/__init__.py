@@ -2,11 +2,14 @@
 
 Importing this module registers, in Gymnasium's ``softbench`` namespace,
 
-  softbench/<robot>-<task>-v0   every benchmark robot with every task of the suite
-  softbench/SoftArm-v0          any robot and task: ``robot=`` and ``task=`` options
+  softbench/<robot>-<task>-vN   every benchmark robot with every task of the suite
+  softbench/SoftArm-vN          any robot and task: ``robot=`` and ``task=`` options
 
-so that ``gymnasium.make("softbench/tendon-3-spiral-v0")`` works after ``import softbench.envs``,
-and without any import as ``gymnasium.make("softbench.envs:softbench/tendon-3-spiral-v0")``
+where vN is the installed physics version (``softbench.robots.versions``): v1 on MuJoCo 4, v0 on
+the old stack (MuJoCo 3.17 with the cable plugin), so an id names the physics it simulates and
+the v0 ids work where the old stack is installed. ``gymnasium.make("softbench/tendon-3-spiral-v1")``
+works after ``import softbench.envs``, and without any import as
+``gymnasium.make("softbench.envs:softbench/tendon-3-spiral-v1")``
 (Gymnasium 1.0 replaced entry-point plugins with this ``module:id`` form). Options go through
 ``gymnasium.make``: the task's (``length``, ``module``, ``steps``, ``trajectory``,
 ``initial_actuation``) and the environment's (``observation``, ``render_mode``, ``width``,
@@ -18,9 +21,10 @@ import gymnasium
 from softbench import robots
 from softbench import suite
 from softbench.envs.environment import SoftArmEnv
+from softbench.robots import versions
 
 NAMESPACE = "softbench"
-VERSION = 0
+VERSION = int(versions.current().name.removeprefix("v"))  # The ids' vN: the physics version.
 ENTRY_POINT = "softbench.envs.environment:SoftArmEnv"
 ANY_ROBOT_ID = f"{NAMESPACE}/SoftArm-v{VERSION}"
 

@@ -1,6 +1,7 @@
 """Every shown row of the leaderboard as one CSV file (``leaderboard/leaderboard.csv``), for
-spreadsheets and scripts: one line per robot, task, agent, profile and eval mode (the newest
-record of each), with every metric's mean, standard deviation and bootstrap interval over seeds.
+spreadsheets and scripts: one line per physics version, robot, task, agent, profile and eval mode
+(the newest record of each), with every metric's mean, standard deviation and bootstrap interval
+over seeds; the current physics' rows first, then each earlier version's.
 
 Figures are written in full (``repr``), not rounded as the pages show them; a metric the record
 does not hold, or an interval with fewer than ``ranking.MIN_SEEDS_FOR_INTERVAL`` seeds, is empty.
@@ -15,7 +16,7 @@ from softbench.leaderboard import links
 from softbench.leaderboard import ranking
 
 FILE_NAME = "leaderboard.csv"
-_SETTING = ("robot", "task", "variant", "agent", "profile", "eval_mode", "seeds")
+_SETTING = ("physics", "robot", "task", "variant", "agent", "profile", "eval_mode", "seeds")
 _STATISTICS = ("mean", "std", "ci_low", "ci_high")
 HEADER = (
   *_SETTING,
@@ -38,13 +39,18 @@ def render(board: ranking.Leaderboard, out: pathlib.Path) -> str:
   text = io.StringIO()
   writer = csv.writer(text, lineterminator="\n")
   writer.writerow(HEADER)
+  for shown in (board, *board.earlier):
+    _write_rows(writer, shown, out)
+  return text.getvalue()
+
+
+def _write_rows(writer, board: ranking.Leaderboard, out: pathlib.Path) -> None:
   for group in board.groups:
     for entry in group.entries:
       agent, profile, eval_mode = entry.setting
-      row = [group.robot, group.task, group.variant, agent, profile, eval_mode]
+      row = [board.physics, group.robot, group.task, group.variant, agent, profile, eval_mode]
       row.append(str(entry.record["seeds"]))
       for metric in records.METRICS:
         row += _figures(entry.estimates.get(metric))
       row += [links.record(entry, out), links.video(entry, out) or ""]
       writer.writerow(row)
-  return text.getvalue()

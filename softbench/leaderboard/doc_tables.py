@@ -7,7 +7,9 @@ A page holds a generated table between two marker lines::
   <!-- /softbench:table -->
 
 ``TABLES`` maps each NAME to a function of the leaderboard (``ranking.Leaderboard``, built from
-the records) that returns a ``figure_table.Table``; the block holds it as the leaderboard's
+the records) that returns a ``figure_table.Table``. ``NAME@vN`` builds it from the records of
+physics version vN (``softbench.robots.versions``; ``ranking.Leaderboard.of_physics``), NAME alone
+from the current physics' records; the block holds it as the leaderboard's
 markdown page renders tables (``markdown_page.table_lines``). Every figure is the leaderboard's:
 mean ± standard deviation over seeds (population, ddof 0) of the newest record of each setting.
 ``softbench leaderboard --write`` rewrites the blocks (``write``), and a test checks that every
@@ -29,6 +31,7 @@ from softbench.leaderboard import overview
 from softbench.leaderboard import paper_tables
 from softbench.leaderboard import ranking
 from softbench.leaderboard.figure_table import Table
+from softbench.robots import versions
 
 START = re.compile(r"^<!-- softbench:table (?P<name>\S+) -->$")
 END = "<!-- /softbench:table -->"
@@ -413,11 +416,29 @@ TABLES: dict[str, Callable[[ranking.Leaderboard], Table]] = {
 }
 
 
+PHYSICS_SEPARATOR = "@"  # NAME@v0: table NAME of the records of physics v0.
+
+
+def _table_and_physics(name: str) -> tuple[str, str | None]:
+  """(table, physics version or None) of a block name; raises DocTableError for an unknown
+  table or physics version."""
+  table, _, physics = name.partition(PHYSICS_SEPARATOR)
+  if table not in TABLES:
+    raise DocTableError(f"unknown table {table!r}; known: {', '.join(TABLES)}")
+  if physics and physics not in versions.VERSIONS:
+    raise DocTableError(
+      f"unknown physics version {physics!r} in table {name!r}; "
+      f"known: {', '.join(versions.VERSIONS)}"
+    )
+  return table, physics or None
+
+
 def render(name: str, board: ranking.Leaderboard) -> str:
-  """The markdown of table ``name`` (its caption, then the table), ending in a newline."""
-  if name not in TABLES:
-    raise DocTableError(f"unknown table {name!r}; known: {', '.join(TABLES)}")
-  return "\n".join(markdown_page.table_lines(TABLES[name](board)))
+  """The markdown of table ``name`` (its caption, then the table; ``NAME@vN`` of physics vN's
+  records), ending in a newline."""
+  table, physics = _table_and_physics(name)
+  shown = board if physics is None else board.of_physics(physics)
+  return "\n".join(markdown_page.table_lines(TABLES[table](shown)))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -442,10 +463,10 @@ def blocks(text: str, page: str = "page") -> list[Block]:
     if start:
       if opened is not None:
         raise DocTableError(f"{page}:{number + 1}: table block inside block {opened[0]!r}")
-      if start["name"] not in TABLES:
-        raise DocTableError(
-          f"{page}:{number + 1}: unknown table {start['name']!r}; known: {', '.join(TABLES)}"
-        )
+      try:
+        _table_and_physics(start["name"])
+      except DocTableError as error:
+        raise DocTableError(f"{page}:{number + 1}: {error}") from None
       opened = start["name"], number + 1
     elif line == END:
       if opened is None:

@@ -95,8 +95,9 @@ def _metric_caption(metric: str) -> str:
   )
 
 
-def _task_boards(group: ranking.Group, out: pathlib.Path) -> tuple[Board, ...]:
-  """``group``'s rows split by profile and eval mode, each ranked, with a chart per metric."""
+def _task_boards(group: ranking.Group, out: pathlib.Path, prefix: str = "") -> tuple[Board, ...]:
+  """``group``'s rows split by profile and eval mode, each ranked, with a chart per metric;
+  ``prefix`` begins each board's anchor (an earlier physics version's section)."""
   by_setting: dict[tuple[str, str], list[ranking.Entry]] = {}
   for entry in group.entries:  # Already ranked.
     by_setting.setdefault(entry.setting[1:], []).append(entry)
@@ -138,7 +139,7 @@ def _task_boards(group: ranking.Group, out: pathlib.Path) -> tuple[Board, ...]:
     )
     boards.append(
       Board(
-        f"{group.anchor}-{profile}-{eval_mode}",
+        f"{prefix}{group.anchor}-{profile}-{eval_mode}",
         f"{profile} profile · {eval_mode}",
         profile,
         eval_mode,
@@ -264,6 +265,30 @@ def _filters(board: ranking.Leaderboard) -> dict[str, list[str]]:
   }
 
 
+@dataclasses.dataclass(frozen=True)
+class Earlier:
+  """An earlier physics version's records, ranked among themselves, as the page shows them."""
+
+  physics: str
+  description: str
+  record_count: int
+  latest_date: str | None
+  task_groups: list
+  exp1s: tuple
+
+
+def _earlier(board: ranking.Leaderboard, out: pathlib.Path) -> Earlier:
+  prefix = f"physics-{board.physics}-"
+  return Earlier(
+    board.physics,
+    board.physics_description,
+    board.record_count,
+    board.latest_date,
+    [(group, _task_boards(group, out, prefix)) for group in board.groups],
+    board.exp1s,
+  )
+
+
 def render(board: ranking.Leaderboard, results: pathlib.Path, out: pathlib.Path) -> str:
   """The page, with links relative to the folder ``out`` it is written to."""
   views = overview.overviews(board)
@@ -277,6 +302,8 @@ def render(board: ranking.Leaderboard, results: pathlib.Path, out: pathlib.Path)
     across=_by_robot((view.robot, _aggregate_board(view)) for view in aggregate.views(board)),
     task_groups=[(group, _task_boards(group, out)) for group in board.groups],
     exp1s=board.exp1s,
+    physics=board.physics_description,
+    earlier=[_earlier(older, out) for older in board.earlier],
     exp1s_explanation=exp1s_board.explanation(),
     exp1s_about_paper=exp1s_board.about_paper(),
     exp1s_tables=exp1s_board.score_tables,

@@ -1,5 +1,6 @@
 """The leaderboard as markdown (``leaderboard/README.md``): the overviews (``overview``), one
-table per robot and task, then the Exp1S records in the paper's layout."""
+table per robot and task, then the Exp1S records in the paper's layout; then, apart, the records
+of each earlier physics version (``ranking.Leaderboard.earlier``), ranked among themselves."""
 
 import pathlib
 
@@ -32,13 +33,25 @@ def _intro(board: ranking.Leaderboard, views: tuple, results_link: str) -> list[
     f"[`{csv_table.FILE_NAME}`](<{csv_table.FILE_NAME}>) (every figure in full).",
     "",
   ]
-  if not board.record_count:
+  if not board.record_count and not board.earlier:
     return lines + [
       "No result records yet. Make one with `softbench run` (for example "
       "`softbench run --task spiral --agent smpl`), then run "
       "`softbench leaderboard --write`.",
       "",
     ]
+  earlier = [
+    f"[{_escaped(older.physics_description)}](#{_earlier_anchor(older)}) ({older.record_count})"
+    for older in board.earlier
+  ]
+  lines += [
+    f"Current physics: {_escaped(board.physics_description)}"
+    + (f"; records of earlier physics, ranked apart: {', '.join(earlier)}." if earlier else ".")
+    + " Records of different physics versions are never ranked together.",
+    "",
+  ]
+  if not board.record_count:
+    return lines + ["No records of the current physics yet.", ""]
   return lines + [
     f"{board.record_count} record(s), the newest from {board.latest_date}. Each row is the "
     "newest record of one agent, profile and eval mode; rows are ranked by position error "
@@ -72,16 +85,22 @@ def _across(views: tuple[aggregate.View, ...]) -> list[str]:
   return lines
 
 
-def _table(group: ranking.Group, out: pathlib.Path) -> list[str]:
+def _earlier_anchor(board: ranking.Leaderboard) -> str:
+  return f"physics-{board.physics}"
+
+
+def _table(group: ranking.Group, out: pathlib.Path, physics: str = "") -> list[str]:
+  """The ranked rows of ``group``; ``physics`` names an earlier version's board in the title
+  and anchor."""
   header = (
     ["#", "agent", "profile", "eval", "seeds"]
     + [ranking.METRIC_LABELS[name] for name in group.metrics]
     + ["video", "record"]
   )
   lines = [
-    f'<a id="{group.anchor}"></a>',
+    f'<a id="{physics}{"-" if physics else ""}{group.anchor}"></a>',
     "",
-    f"## {group.title}",
+    f"## {group.title}" + (f" · physics {physics}" if physics else ""),
     "",
     "| " + " | ".join(header) + " |",
     "|" + "|".join("---:" if name in ("#", "seeds") else "---" for name in header) + "|",
@@ -124,8 +143,13 @@ def table_lines(table: figure_table.Table) -> list[str]:
   ]
 
 
-def _exp1s_group(group: exp1s_board.Group, out: pathlib.Path) -> list[str]:
-  lines = [f'<a id="{group.anchor}"></a>', "", f"## {group.title}", ""]
+def _exp1s_group(group: exp1s_board.Group, out: pathlib.Path, physics: str = "") -> list[str]:
+  lines = [
+    f'<a id="{physics}{"-" if physics else ""}{group.anchor}"></a>',
+    "",
+    f"## {group.title}" + (f" · physics {physics}" if physics else ""),
+    "",
+  ]
   for entry in group.entries:
     lines += [
       f"### {_escaped(entry.label)}",
@@ -159,4 +183,25 @@ def render(board: ranking.Leaderboard, results: pathlib.Path, out: pathlib.Path)
     lines += _table(group, out)
   for group in board.exp1s:
     lines += _exp1s_group(group, out)
+  for older in board.earlier:
+    lines += _earlier(older, out)
   return "\n".join(lines).rstrip("\n") + "\n"
+
+
+def _earlier(board: ranking.Leaderboard, out: pathlib.Path) -> list[str]:
+  """An earlier physics version's records, ranked among themselves, after everything else."""
+  lines = [
+    f'<a id="{_earlier_anchor(board)}"></a>',
+    "",
+    f"# Earlier physics: {_escaped(board.physics_description)}",
+    "",
+    f"{board.record_count} record(s), the newest from {board.latest_date}, simulated with "
+    f"{_escaped(board.physics_description)}: ranked among themselves, never with the current "
+    "physics' records. Reproduce them on that stack: docs/physics-versions.md.",
+    "",
+  ]
+  for group in board.groups:
+    lines += _table(group, out, board.physics)
+  for group in board.exp1s:
+    lines += _exp1s_group(group, out, board.physics)
+  return lines

@@ -9,6 +9,10 @@ a 95 % percentile bootstrap confidence interval of the mean (``scipy.stats.boots
 rliable uses by default), with a fixed random generator so that the same records give the same
 numbers; with fewer than 2 seeds there is no interval. Exp1S records are grouped apart
 (``exp1s_board``), in the paper's layout rather than a ranking.
+
+Records of different physics versions (``softbench.robots.versions``) are never ranked together:
+the board holds the records of the newest version any record has, and each earlier version's
+records form a board of their own (``Leaderboard.earlier``), which the pages show apart.
 """
 
 from collections.abc import Iterator
@@ -27,6 +31,7 @@ from softbench import suite
 from softbench.leaderboard import exp1s_board
 from softbench.leaderboard import selection
 from softbench.records import fields as record_fields
+from softbench.robots import versions
 
 CONFIDENCE = 0.95
 BOOTSTRAP_RESAMPLES = 10_000
@@ -169,9 +174,24 @@ class Group:
 @dataclasses.dataclass(frozen=True)
 class Leaderboard:
   groups: tuple[Group, ...]  # Of softbench run records.
-  record_count: int  # Of every kind.
+  record_count: int  # Of every kind, of this board's physics version.
   latest_date: str | None  # The newest record's date: the pages carry no time of their own.
   exp1s: tuple[exp1s_board.Group, ...] = ()  # Of softbench run --protocol exp1s records.
+  physics: str = versions.LATEST  # The physics version of every record on the board.
+  earlier: tuple["Leaderboard", ...] = ()  # The records of earlier physics versions, oldest first.
+
+  @property
+  def physics_description(self) -> str:
+    return f"physics {self.physics} ({versions.VERSIONS[self.physics].description})"
+
+  def of_physics(self, name: str) -> "Leaderboard":
+    """The board of physics version ``name``: this one or an earlier one (empty if no record
+    has that version)."""
+    for board in (self, *self.earlier):
+      if board.physics == name:
+        return board
+    versions.VERSIONS[name]  # KeyError for an unknown name.
+    return Leaderboard((), 0, None, physics=name)
 
 
 def _group_key(record: dict) -> tuple[str, str, str]:
@@ -217,7 +237,22 @@ def _moment(record: dict) -> datetime.datetime:
 
 
 def rank(loaded: list[tuple[pathlib.Path, dict]]) -> Leaderboard:
-  """The leaderboard of checked records (``records.read_folder``) of every kind."""
+  """The leaderboard of checked records (``records.read_folder``) of every kind: the records of
+  the newest physics version among them (the installed one if there are none), with a board of
+  its own for each earlier version's."""
+  by_physics: dict[str, list] = {}
+  for path, record in loaded:
+    by_physics.setdefault(record_fields.physics_of(record), []).append((path, record))
+  order = list(versions.VERSIONS)
+  newest = max(by_physics, key=order.index, default=versions.current().name)
+  earlier = tuple(
+    _rank_one(by_physics[name], name) for name in order if name in by_physics and name != newest
+  )
+  return dataclasses.replace(_rank_one(by_physics.get(newest, []), newest), earlier=earlier)
+
+
+def _rank_one(loaded: list[tuple[pathlib.Path, dict]], physics: str) -> Leaderboard:
+  """The leaderboard of checked records of one physics version."""
   by_group: dict[tuple[str, str, str], list[Entry]] = {}
   for path, record in loaded:
     # Adaptive activation records hold per-target results, no per-seed ones (softbench.adaptive).
@@ -234,6 +269,7 @@ def rank(loaded: list[tuple[pathlib.Path, dict]]) -> Leaderboard:
     len(loaded),
     None if latest is None else latest["date"],
     exp1s_board.group(loaded),
+    physics,
   )
 
 

@@ -26,9 +26,10 @@ def _aligned(rows: list[list[str]], right: set[int]) -> list[str]:
 def summary(board: ranking.Leaderboard, results: pathlib.Path, asked_for: str = "") -> str:
   """The first line: how many records (of those ``asked_for``, if only some), from where, and
   how to read the figures."""
-  if not board.record_count and asked_for:
+  total = board.record_count + sum(older.record_count for older in board.earlier)
+  if not total and asked_for:
     return f"no result records of {asked_for} in {results}"
-  if not board.record_count:
+  if not total:
     where = "no folder" if not pathlib.Path(results).exists() else "an empty folder"
     option = "" if pathlib.Path(results) == records.DEFAULT_FOLDER else f" --results {results}"
     return (
@@ -36,7 +37,15 @@ def summary(board: ranking.Leaderboard, results: pathlib.Path, asked_for: str = 
       f"softbench run --task spiral --agent smpl{option}"
     )
   of = f" of {asked_for}" if asked_for else ""
-  parts = [f"{board.record_count} result record(s){of} in {results}, newest {board.latest_date}"]
+  parts = [
+    f"{board.record_count} result record(s){of} in {results}"
+    + (f", newest {board.latest_date}" if board.record_count else "")
+    + f" ({board.physics_description})"
+  ]
+  parts += [
+    f"{older.record_count} of {older.physics_description}, ranked apart below"
+    for older in board.earlier
+  ]
   if board.groups:
     parts.append(
       f"one row per agent, profile and eval mode (its newest record), ranked by "
@@ -100,12 +109,18 @@ def overview_section(views: tuple[overview.Overview, ...]) -> list[str]:
 
 
 def report(board: ranking.Leaderboard, results: pathlib.Path, asked_for: str = "") -> str:
-  """The whole printout (of the records ``asked_for``, if only some)."""
-  return "\n\n".join(
-    [
-      summary(board, results, asked_for),
-      *overview_section(overview.overviews(board)),
-      *(table(group) for group in board.groups),
-      *(exp1s_section(group) for group in board.exp1s),
+  """The whole printout (of the records ``asked_for``, if only some); each earlier physics
+  version's records after the current one's, ranked among themselves."""
+  sections = [
+    summary(board, results, asked_for),
+    *overview_section(overview.overviews(board)),
+    *(table(group) for group in board.groups),
+    *(exp1s_section(group) for group in board.exp1s),
+  ]
+  for older in board.earlier:
+    sections += [
+      f"== earlier physics: {older.physics_description}, ranked apart ==",
+      *(f"{table(group)}" for group in older.groups),
+      *(exp1s_section(group) for group in older.exp1s),
     ]
-  )
+  return "\n\n".join(sections)

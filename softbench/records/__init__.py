@@ -52,6 +52,7 @@ _OPTIONAL_FIELDS = (
   "helpers",
   "given",
   record_fields.WEIGHTS_FIELD,
+  *record_fields.OPTIONAL_FIELDS,
 )
 ADAPTIVE_SECTION = "adaptive"  # softbench run --adaptive: per-target results, no per-seed ones.
 _MEAN_TOLERANCE = 1e-9  # Relative: a seed's mean against the mean of its per-module values.

@@ -80,7 +80,7 @@ def schema() -> dict:
     "$schema": "https://json-schema.org/draft/2020-12/schema",
     "title": "softbench Exp1S result record",
     "type": "object",
-    "required": list(properties),
+    "required": [name for name in properties if name not in record_fields.OPTIONAL_FIELDS],
     "properties": {**properties, **optional},
     "additionalProperties": record_fields.section(),
   }

@@ -11,6 +11,7 @@ from typing import NoReturn
 
 from softbench import profiles
 from softbench import robots
+from softbench.robots import versions
 
 INTEGRITY_FIELD = "sha256"
 METRICS = ("position_mm", "orientation_deg", "normalised_tip_percent")  # Every record kind's.
@@ -35,6 +36,17 @@ Refuse = Callable[[str], NoReturn]
 def non_negative(maximum: float = MAX_ERROR) -> dict:
   """A number from 0 to ``maximum``."""
   return {"type": "number", "minimum": 0, "maximum": maximum}
+
+
+PHYSICS_FIELD = "physics"
+"""The physics version a record was simulated with (``softbench.robots.versions``); records made
+before there were versions (up to 2026-12-06) lack it and are v0."""
+PHYSICS_BEFORE_VERSIONS = "v0"
+
+
+def physics_of(record: dict) -> str:
+  """The physics version of a checked record."""
+  return record.get(PHYSICS_FIELD, PHYSICS_BEFORE_VERSIONS)
 
 
 WEIGHTS_FIELD = "weights"
@@ -92,8 +104,12 @@ def properties() -> dict:
     "wall_time_s": non_negative(MAX_WALL_TIME_S),
     "date": {"type": "string", "format": "date-time"},
     "machine": {"type": "object"},
+    PHYSICS_FIELD: {"enum": list(versions.VERSIONS)},
     INTEGRITY_FIELD: {"type": "string", "pattern": "^[0-9a-f]{64}$"},
   }
+
+
+OPTIONAL_FIELDS = (PHYSICS_FIELD,)  # Of ``properties``: every record kind may lack them.
 
 
 def check(record: dict, refuse: Refuse, seed_entries: int | None = None) -> None:

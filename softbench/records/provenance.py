@@ -1,6 +1,6 @@
 """Provenance of a record: softbench's version, the git commit (``-dirty`` with local changes), the
-date and the machine (platform, CPU model and widest vector extension, cores, Python, torch and
-the device it computed on)."""
+date, the physics version (``softbench.robots.versions``) and the machine (platform, CPU model and
+widest vector extension, cores, Python, MuJoCo, torch and the device it computed on)."""
 
 import datetime
 from importlib import metadata
@@ -10,6 +10,7 @@ import platform
 import subprocess
 
 import softbench
+from softbench.robots import versions
 
 
 def _git_commit() -> str | None:
@@ -39,6 +40,7 @@ def _machine(device: str) -> dict:
     "processor": _processor(),
     "cpu_count": os.cpu_count(),
     "python": platform.python_version(),
+    "mujoco": metadata.version("mujoco"),
     "torch": metadata.version("torch"),
     "device": device,
   }
@@ -67,6 +69,7 @@ def provenance(device: str) -> dict:
     "softbench_version": softbench.__version__,
     "git_commit": _git_commit(),
     "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+    "physics": versions.current().name,
     "machine": _machine(device),
   }
 

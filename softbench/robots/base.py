@@ -9,12 +9,14 @@ the robot (``softbench.robots.physics.SoftArmPhysics`` reads it back).
 import abc
 import dataclasses
 import functools
+import hashlib
 import math
 
 import mujoco
 import numpy as np
 
 from softbench.robots import faults as fault_model
+from softbench.robots import versions
 
 ACTION_MAP_NAME = "action_map"
 XML_CACHE_SIZE = 16  # Robots whose MJCF each process keeps (under 0.5 MB each up to 10 modules).
@@ -170,6 +172,15 @@ class SoftArm(abc.ABC):
     """The robot's MJCF, generated once per process for equal robots (frozen specs): every
     environment, reference and cache key asks for it, and generating it takes 10 to 200 ms."""
     return _generated_xml(self)
+
+  def physics_sha256(self) -> str:
+    """The sha256 that cache keys (datasets, references, checkpoints) name the robot's physics
+    by: of its MJCF, with the physics version after v0 (``softbench.robots.versions``), so that a
+    robot whose MJCF is the same on two versions (the pneumatic arm) keys apart on each, while
+    the keys made on v0 still hold there."""
+    version = versions.current().name
+    text = self.to_xml() + ("" if version == versions.FIRST else f"\n<!-- physics {version} -->")
+    return hashlib.sha256(text.encode()).hexdigest()
 
   def compile(self) -> mujoco.MjModel:
     """The model exactly as its exported MJCF loads (the XML rounds numbers to 6 digits, so

@@ -11,6 +11,19 @@ square of the segment length and orientations at module tips are second-order ac
 Every body has its local x-axis along the arm (the convention of MuJoCo's cable plugin, which
 applies torsion about local x). A clamp body, welded to the base, holds the rod's first half
 segment. Each module's tip carries a site ``module{k}_tip`` whose z-axis is the arm axis.
+
+Bending and twisting stiffness are set separately, with elements that MuJoCo 4, MJX and MuJoCo
+Warp all support. MuJoCo's cable plugin (removed in MuJoCo 4) puts the generalised force
+f = -Rᵀ K ω / l on each ball joint, with ω the rotation vector of the joint, R its rotation,
+K = diag(G·J, E·I, E·I) and l the segment length. Since Rᵀ ω = ω, that is
+-(E·I / l) ω + ((E·I - G·J) / l) ω_x Rᵀ e_x: the ball joint's own spring (stiffness E·I / l,
+isotropic, exactly MuJoCo's ball spring) plus a torque about the parent segment's x-axis that grows
+with the twist component of ω. MuJoCo's ``jointinparent`` transmission gives exactly that on a
+ball joint (length ω·e_x, moment Rᵀ e_x), so each joint gets a torsion actuator with no control
+(gain 0) and an affine bias of (E·I - G·J) / l times its length. Together they reproduce the
+plugin's law to rounding, including its non-conservative second-order term, which no arrangement
+of joint springs (a twist hinge in series with a ball, or three hinges) can: those were measured
+up to 1.1 mm (series) and 10.8 mm (hinges) away from the plugin's equilibria on tendon-3.
 """
 
 import dataclasses
@@ -35,6 +48,9 @@ class SegmentJoints:
     bending_stiffness: E·I of the rod (N·m²) that the ball joints reproduce, each with rotational
       stiffness E·I / (distance between the origins of the two bodies it joins); 0 when the cable
       plugin supplies the elasticity.
+    torsional_stiffness: G·J of the rod (N·m²), or None for a rod that twists as stiffly as it
+      bends (a plain ball spring). Otherwise every joint also gets a torsion actuator (see the
+      module's docstring; ``add_torsion_actuators``).
     ball_damping: Rotational damping (N·m·s/rad).
     armature: Added inertia of every joint DOF (kg·m²); it tames the highest frequencies of short
       segments so that a larger time step stays stable, and leaves equilibria unchanged.
@@ -46,6 +62,7 @@ class SegmentJoints:
   bending_stiffness: float
   ball_damping: float
   armature: float
+  torsional_stiffness: float | None = None
   slide_stiffness: float | None = None
   slide_damping: float = 0.0
 
@@ -100,13 +117,25 @@ def tip_site_name(module: int) -> str:
   return f"module{module}_tip"
 
 
+def torsion_actuator_name(segment: str) -> str:
+  """Name of the torsion actuator of the joint that carries ``segment``."""
+  return f"{segment}_torsion"
+
+
 class Chain:
   """The bodies of a built chain, and where along the rod each one starts."""
 
-  def __init__(self, bodies: list[mujoco.MjsBody], origins: list[float], geometry: ChainGeometry):
+  def __init__(
+    self,
+    bodies: list[mujoco.MjsBody],
+    origins: list[float],
+    geometry: ChainGeometry,
+    joints: SegmentJoints,
+  ):
     self.bodies = bodies  # The clamp first, then every segment.
     self.origins = origins  # Rest arc length (m) of each body's origin.
     self.geometry = geometry
+    self.joints = joints
 
   def locate(self, arc_length: float) -> tuple[mujoco.MjsBody, float]:
     """The body holding the rod at ``arc_length`` and the local x of that point (m)."""
@@ -181,7 +210,7 @@ def add_chain(
       body.plugin = cable_plugin
     bodies.append(body)
     origins.append(start)
-  built = Chain(bodies, origins, geometry)
+  built = Chain(bodies, origins, geometry, joints)
   for module in range(1, geometry.num_modules + 1):
     built.add_site(
       tip_site_name(module),
@@ -191,6 +220,33 @@ def add_chain(
       rgba=(1, 1, 1, 1),
     )
   return built
+
+
+def add_torsion_actuators(spec: mujoco.MjSpec, rod: Chain) -> int:
+  """Gives every ball joint of ``rod`` the torsion actuator that makes its twisting stiffness
+  G·J / l while its spring bends with E·I / l (see the module's docstring); returns how many
+  were added (none for a rod whose ``torsional_stiffness`` is None).
+
+  Add them after the robot's own actuators, whose indices the action map and faults count.
+  """
+  joints = rod.joints
+  if joints.torsional_stiffness is None:
+    return 0
+  for body, origin, previous in zip(rod.bodies[1:], rod.origins[1:], rod.origins[:-1]):
+    spacing = origin - previous
+    softening = (joints.bending_stiffness - joints.torsional_stiffness) / spacing  # (N·m/rad)
+    spec.add_actuator(
+      name=torsion_actuator_name(body.name),
+      trntype=mujoco.mjtTrn.mjTRN_JOINTINPARENT,
+      target=f"{body.name}_ball",
+      gear=(1, 0, 0, 0, 0, 0),  # The parent segment's x-axis: the rod's axis before the joint.
+      gaintype=mujoco.mjtGain.mjGAIN_FIXED,
+      gainprm=[0.0] * 10,  # No control: a passive element.
+      biastype=mujoco.mjtBias.mjBIAS_AFFINE,
+      biasprm=[0.0, softening] + [0.0] * 8,
+      ctrllimited=mujoco.mjtLimited.mjLIMITED_FALSE,
+    )
+  return len(rod.bodies) - 1
 
 
 def _add_rod_geom(

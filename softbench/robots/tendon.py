@@ -1,12 +1,13 @@
 """``tendon-N``: a modular tendon-driven soft arm, cables crossing the proximal modules (SPEC 2.1).
 
 N modules of 50 mm hang from a fixed base under gravity. The backbone is a silicone rod cut into
-rigid segments whose elasticity comes from MuJoCo's ``mujoco.elasticity.cable`` plugin (the
-default, as ``<composite type="cable">`` expands) or, plugin-free, from ball joints of stiffness
-E·I / segment length. Each module has four cables at 90 degrees, routed as spatial tendons through
-holes near both ends of every segment (a channel along the rod) and anchored at the module's
-tip; a cable of module k passes through all of modules 1..k-1, closer to the axis, so actuating
-a distal module also bends the proximal ones.
+rigid segments whose elasticity bends with E·I and twists with G·J: plugin-free (``backbone="rod"``,
+physics v1: ball-joint springs and a torsion actuator per joint, ``softbench.robots.chain``) or from
+MuJoCo 3's ``mujoco.elasticity.cable`` plugin (``backbone="cable"``, physics v0, as
+``<composite type="cable">`` expands); the two give the same forces to rounding. Each module has
+four cables at 90 degrees, routed as spatial tendons through holes near both ends of every segment
+(a channel along the rod) and anchored at the module's tip; a cable of module k passes through all
+of modules 1..k-1, closer to the axis, so actuating a distal module also bends the proximal ones.
 
 Action: two values per module in [-1, 1]. Value a of axis x pulls the +x cable with tension
 max(0, a)·Tmax and the -x cable with max(0, -a)·Tmax (the paper's antagonistic convention);
@@ -29,10 +30,11 @@ import numpy as np
 from softbench.robots import base
 from softbench.robots import chain
 from softbench.robots import faults as fault_model
+from softbench.robots import versions
 
 MODULE_LENGTH = 0.05  # (m) Paper: "Each module has a length of 50 mm".
 MAX_MODULES = 10  # Largest N that builds; N = 1 .. 5 are the benchmark configurations.
-BACKBONES = ("cable", "joints")
+BACKBONES = ("rod", "cable")  # versions.PhysicsVersion.backbone of physics v1 and v0.
 # Cables, as (name, angle around the arm in degrees, action axis, sign of the action that pulls it).
 _CABLES = (
   ("xpos", 0.0, 0, +1),
@@ -74,7 +76,8 @@ class CableDrivenArm(base.SoftArm):
       paper's simulator, so that long arms settle within one control period; joint damping alone
       damps only relative motion and left tendon-5 swinging for seconds.
     armature: Added inertia of every joint DOF (kg·m²).
-    backbone: ``"cable"`` (cable plugin) or ``"joints"`` (ball-joint springs, no plugin).
+    backbone: ``"rod"`` (plugin-free, physics v1) or ``"cable"`` (MuJoCo 3's cable plugin,
+      physics v0); by default the backbone of the installed physics version.
     timestep: Physics time step (s).
     control_period: Time between two actions (s).
     faults: Faulty cables (``softbench.robots.faults``; actuator i of a module is cable
@@ -94,7 +97,7 @@ class CableDrivenArm(base.SoftArm):
   damping: float = 2.0e-3
   medium_viscosity: float = 0.1
   armature: float = 1.0e-5
-  backbone: str = "cable"
+  backbone: str = versions.current().backbone
   timestep: float = 4.0e-3
   control_period: float = 1.0
   faults: tuple[fault_model.Fault, ...] = ()
@@ -136,6 +139,8 @@ class CableDrivenArm(base.SoftArm):
       raise ValueError(f"poisson_ratio must lie in [0, 0.5], got {self.poisson_ratio!r}")
     if self.backbone not in BACKBONES:
       raise ValueError(f"unknown backbone {self.backbone!r}; choose one of {', '.join(BACKBONES)}")
+    if self.backbone == "cable" and not versions.cable_plugin_available():
+      raise ValueError(versions.CABLE_PLUGIN_MISSING)
     fault_model.check(self, self.faults)
 
   @classmethod
@@ -174,6 +179,11 @@ class CableDrivenArm(base.SoftArm):
     return self.youngs_modulus * math.pi * self.radius**4 / 4
 
   @property
+  def torsional_stiffness(self) -> float:
+    """G·J of the backbone (N·m²): G = E / (2 (1 + nu)) and J = 2 I for a circular section."""
+    return self.youngs_modulus / (2 * (1 + self.poisson_ratio)) * math.pi * self.radius**4 / 2
+
+  @property
   def segment_length(self) -> float:
     return self.module_length / self.segments_per_module
 
@@ -185,7 +195,9 @@ class CableDrivenArm(base.SoftArm):
         pulled_at_plus = self.max_tension if sign > 0 else 0.0
         pulled_at_minus = self.max_tension if sign < 0 else 0.0
         maps.append(base.ActuatorMap(index, pulled_at_minus, 0.0, pulled_at_plus))
-    return maps
+    # The rod's torsion actuators (one per segment joint) follow the cables and take no control.
+    torsion = self.num_modules * self.segments_per_module if self.backbone == "rod" else 0
+    return maps + [base.ActuatorMap(0, 0.0, 0.0, 0.0)] * torsion
 
   def mirror_action(self, action: np.ndarray) -> np.ndarray:
     # Every cable has an opposite one: -a pulls the opposite cables, i.e. the arm turned by
@@ -224,13 +236,15 @@ class CableDrivenArm(base.SoftArm):
         "bend": repr(self.youngs_modulus),
         "vmax": "0",
       }
-      joint_bending_stiffness = 0.0
+      joints = chain.SegmentJoints(0.0, ball_damping=self.damping, armature=self.armature)
     else:
       plugin = None
-      joint_bending_stiffness = self.bending_stiffness
-    joints = chain.SegmentJoints(
-      bending_stiffness=joint_bending_stiffness, ball_damping=self.damping, armature=self.armature
-    )
+      joints = chain.SegmentJoints(
+        self.bending_stiffness,
+        ball_damping=self.damping,
+        armature=self.armature,
+        torsional_stiffness=self.torsional_stiffness,
+      )
     base_body = spec.worldbody.add_body(name="base")
     base_body.add_geom(
       name="base_plate",
@@ -243,6 +257,7 @@ class CableDrivenArm(base.SoftArm):
     )
     rod = chain.add_chain(base_body, geometry, joints, _MODULE_RGBA, plugin)
     self._add_cables(spec, rod)
+    chain.add_torsion_actuators(spec, rod)
 
   @abc.abstractmethod
   def cable_route(self, rod: chain.Chain, module: int) -> list[tuple[str, float, float]]:

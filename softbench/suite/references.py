@@ -179,7 +179,7 @@ def _config(robot: base.SoftArm, shape: str, length: int) -> dict:
     "robot": robot.name,
     "shape": shape,
     "length": length,
-    "robot_xml_sha256": hashlib.sha256(robot.to_xml().encode()).hexdigest(),
+    "robot_xml_sha256": robot.physics_sha256(),
     "bend_deg": BEND_DEG,
     "amplitude_grid": AMPLITUDE_GRID.tolist(),
     "lead_in": LEAD_IN,

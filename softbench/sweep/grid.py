@@ -35,6 +35,8 @@ from softbench.agents import forward_models
 from softbench.agents import learned
 from softbench.agents import learners
 from softbench.data import dataset as babbling_dataset
+from softbench.records import fields as record_fields
+from softbench.robots import versions
 
 KINDS = ("dataset", "forward", "agent", "network")  # What a build makes (network: Exp1S's).
 Setting = run_module.RunSettings | continual.RunSettings  # A task's run, or an Exp1S run.
@@ -164,9 +166,10 @@ def setting_name(run: Setting) -> str:
 
 def existing_record(run: Setting, results: pathlib.Path) -> pathlib.Path | None:
   """The oldest record of ``run``'s setting in ``results``: a file named ``setting_name``, then a
-  date, as ``run.record_path`` (or ``continual.record_path``) names it, that holds as many seeds
-  and, for a task, completed partial targets the same way (``helpers``; a record without any
-  did not complete them); None if there is none.
+  date, as ``run.record_path`` (or ``continual.record_path``) names it, that was simulated with
+  the installed physics version and holds as many seeds and, for a task, completed partial
+  targets the same way (``helpers``; a record without any did not complete them); None if there
+  is none.
 
   Raises:
     records.RecordError: such a file is not a valid, untouched record (one line).
@@ -174,7 +177,8 @@ def existing_record(run: Setting, results: pathlib.Path) -> pathlib.Path | None:
   wanted = _unnamed_settings(run)
   for path in sorted(results.glob(f"{setting_name(run)}-*.json")):
     record = records.read(path)
-    if {field: record.get(field) for field in wanted} == wanted:
+    same_physics = record_fields.physics_of(record) == versions.current().name
+    if same_physics and {field: record.get(field) for field in wanted} == wanted:
       return path
   return None
 

@@ -22,7 +22,6 @@ trains the previous and the best values again at the profile's full budget, as t
 
 import dataclasses
 import datetime
-import hashlib
 import json
 import math
 import os
@@ -82,7 +81,7 @@ class TuneSettings:
     return {
       "agent": self.agent,
       "robot": self.robot,
-      "robot_xml_sha256": hashlib.sha256(arm.to_xml().encode()).hexdigest(),
+      "robot_xml_sha256": arm.physics_sha256(),
       "profile": self.profile.name,
       "samples": self.profile.samples,
       "max_epochs": self.profile.max_epochs,
