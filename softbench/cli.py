@@ -241,6 +241,26 @@ def _add_results_argument(
 def _add_record_arguments(parser: argparse.ArgumentParser) -> None:
   _add_results_argument(parser)
   parser.add_argument("--json", help="also write the result record to this file")
+  _add_physics_argument(parser)
+
+
+def _add_physics_argument(parser: argparse.ArgumentParser) -> None:
+  from softbench.robots import versions
+
+  parser.add_argument(
+    "--physics",
+    metavar="VERSION",
+    help=f"the physics version to simulate, of {', '.join(versions.VERSIONS)} (default: the "
+    f"installed one, {versions.current().name}); another is refused, saying how to install it",
+  )
+
+
+def _check_physics(args: argparse.Namespace) -> None:
+  """Refuses a ``--physics`` that is unknown or not the installed one (one line)."""
+  from softbench.robots import versions
+
+  if args.physics is not None:
+    versions.check(args.physics)
 
 
 def _json_copy(args: argparse.Namespace) -> pathlib.Path | None:
@@ -248,7 +268,9 @@ def _json_copy(args: argparse.Namespace) -> pathlib.Path | None:
 
 
 def _check_record_arguments(args: argparse.Namespace) -> None:
-  """Refuses a ``--results`` or ``--json`` that could not be written, before the run."""
+  """Refuses a ``--physics`` this installation does not run, and a ``--results`` or ``--json``
+  that could not be written, before the run."""
+  _check_physics(args)
   storage.check_writable(args.results, "result records to", folder=True)
   if args.json:
     storage.check_writable(args.json, "result record")
@@ -258,6 +280,7 @@ def _sweep(args: argparse.Namespace) -> None:
   from softbench import continual
   from softbench import sweep
 
+  _check_physics(args)
   if args.protocol is None and args.families is not None:
     raise ValueError(f"--families goes with --protocol {continual.PROTOCOL}")
   if args.protocol is not None:
@@ -288,11 +311,15 @@ def _leaderboard(args: argparse.Namespace) -> None:
     return
   results = pathlib.Path(args.results)
   record_filter = filters.RecordFilter(
-    *(tuple(names or ()) for names in (args.robots, args.tasks, args.agents, args.profiles))
+    *(
+      tuple(names or ())
+      for names in (args.robots, args.tasks, args.agents, args.profiles, args.physics)
+    )
   )
   if args.write and record_filter.active:
     raise ValueError(
-      "--write writes the whole leaderboard; drop --robots, --tasks, --agents and --profiles"
+      "--write writes the whole leaderboard; drop --robots, --tasks, --agents, --profiles and "
+      "--physics"
     )
   board = leaderboard.build(results, record_filter)
   print(leaderboard.text.report(board, results, record_filter.describe()))
@@ -577,6 +604,7 @@ def _sweep_arguments(parser: argparse.ArgumentParser) -> None:
     "(default: $SOFTBENCH_HOME)",
   )
   _add_results_argument(parser)
+  _add_physics_argument(parser)
   parser.add_argument(
     "--dry-run",
     action="store_true",
@@ -605,17 +633,18 @@ def _leaderboard_arguments(parser: argparse.ArgumentParser) -> None:
     choices=tuple(grid.lists()),
     help="print the names on one axis of the grid make leaderboard fills, and nothing else",
   )
-  for axis, example in (
-    ("robots", "tendon-3"),
-    ("tasks", "reach"),
-    ("agents", "smpl lstm"),
-    ("profiles", "paper"),
+  for axis, metavar, what, example in (
+    ("robots", "ROBOT", "robots", "tendon-3"),
+    ("tasks", "TASK", "tasks", "reach"),
+    ("agents", "AGENT", "agents", "smpl lstm"),
+    ("profiles", "PROFILE", "profiles", "paper"),
+    ("physics", "VERSION", "physics versions", "v0"),
   ):
     parser.add_argument(
       f"--{axis}",
       nargs="+",
-      metavar=axis[:-1].upper(),
-      help=f"print only the records of these {axis}, e.g. {example}",
+      metavar=metavar,
+      help=f"print only the records of these {what}, e.g. {example}",
     )
 
 

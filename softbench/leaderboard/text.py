@@ -40,7 +40,7 @@ def summary(board: ranking.Leaderboard, results: pathlib.Path, asked_for: str = 
   parts = [
     f"{board.record_count} result record(s){of} in {results}"
     + (f", newest {board.latest_date}" if board.record_count else "")
-    + f" ({board.physics_description})"
+    + f", {board.physics_description}"
   ]
   parts += [
     f"{older.record_count} of {older.physics_description}, ranked apart below"

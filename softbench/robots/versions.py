@@ -49,7 +49,7 @@ VERSIONS = {
       "mujoco>=3.17,<4",
       3,
       "cable",
-      "MuJoCo 3.17 + cable plugin rod",
+      "MuJoCo 3.17 + cable plugin",
       "make install-v0 (the old stack in .venv-v0: constraints-v0.txt)",
     ),
     PhysicsVersion(
@@ -114,7 +114,7 @@ def check(name: str) -> PhysicsVersion:
       install it).
   """
   if name not in VERSIONS:
-    raise ValueError(f"unknown physics version {name!r}; choose one of {', '.join(VERSIONS)}")
+    raise ValueError(f"unknown physics version {name!r}; choose from {', '.join(VERSIONS)}")
   version = VERSIONS[name]
   if version != current():
     raise ValueError(
