@@ -44,10 +44,11 @@ run-v0: $(STAMP_V0)
 test: $(STAMP)
 	$(VENV)/bin/python -m pytest -q -n auto --dist worksteal tests
 
-# CI's check of the old stack: the rod against the cable plugin live, and one robot, task and
-# agent end to end (tests/test_old_stack.py), on physics v0.
+# CI's check of the old stack (physics v0): the rod against the cable plugin live, the versions'
+# bookkeeping, and one robot, task and agent end to end (tests/test_old_stack.py).
 smoke-v0: $(STAMP_V0)
-	$(VENV_V0)/bin/python -m pytest -q -p no:cacheprovider tests/test_rod.py tests/test_old_stack.py
+	$(VENV_V0)/bin/python -m pytest -q -p no:cacheprovider tests/test_rod.py tests/test_versions.py \
+	  tests/test_old_stack.py
 
 bench: $(STAMP)
 	$(VENV)/bin/python -m pytest -q benchmarks --benchmark-only --benchmark-columns=mean,stddev,rounds
