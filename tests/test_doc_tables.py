@@ -22,6 +22,7 @@ ONE_OFF_TABLE_HEADERS = (
   "| robot, fault |",  # docs/faults.md: records of the fault experiment, in docs/faults/.
   "| stage |",  # docs/adaptive-activation.md: adaptive activation per stage.
   "| CPU |",  # docs/paper-comparison.md: SAC on two kinds of CPU (docs/analysis/sweep_vs_loop/sac).
+  "| record (v0) |",  # docs/physics-versions.md: v0 records re-scored on v1 (rescore_on_v1.py).
 )
 EXP1S_RECORD = "smpl-exp1s-default-2026-11-24T041101Z.json"
 
