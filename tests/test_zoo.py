@@ -20,6 +20,7 @@ from softbench import zoo
 from softbench.agents import learned
 from softbench.data import dataset as data_files
 from softbench.leaderboard import zoo_catalogue as catalogue
+from softbench.robots import versions
 
 LEARNED_AGENTS = agents.babbling_learners()  # The agents whose weights the zoo keeps.
 CHECKOUT = pathlib.Path(__file__).resolve().parents[1]
@@ -317,6 +318,7 @@ def test_cli_run_add_and_verify_reproduce_a_record_from_the_zoo(
   entries = zoo.read_manifest(folder).values()
   assert {entry.kind for entry in entries} == {"agent", "forward"}
   assert all(entry.records == (path.name,) for entry in entries if entry.kind == "agent")
+  assert {entry.physics for entry in entries} == {versions.current().name}  # As the record's.
   # A fresh clone: an empty data home re-scores the record without babbling or training.
   use(monkeypatch, tmp_path / "empty", folder)
   with monkeypatch.context() as patched:

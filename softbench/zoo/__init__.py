@@ -61,6 +61,8 @@ class Entry:
   key: str  # The cache key the file answers (a checkpoint's file name without .pt).
   config: dict = dataclasses.field(default_factory=dict)  # As stored in the checkpoint.
   records: tuple[str, ...] = ()  # File names of the records it stands behind.
+  physics: str = "v0"  # The physics version it was trained on (softbench.robots.versions);
+  # entries made before versions (2026-12-06) lack the field and are v0.
 
   def to_json(self) -> dict:
     return {**dataclasses.asdict(self), "records": list(self.records)}
@@ -125,6 +127,12 @@ def read_manifest(zoo: pathlib.Path) -> dict[str, Entry]:
       f"{path}: unreadable zoo manifest ({type(error).__name__}: {first_line(error)})"
     ) from None
   return {entry.path: entry for entry in entries}
+
+
+def _installed_physics() -> str:
+  from softbench.robots import versions  # Here: it imports MuJoCo, which reading the zoo needs not.
+
+  return versions.current().name
 
 
 def _inside(relative: str) -> bool:
@@ -305,6 +313,7 @@ def add(
           cache_file.stem,
           config,
           records,
+          _installed_physics(),
         ),
       )
   if not planned:

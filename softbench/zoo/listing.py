@@ -21,15 +21,15 @@ def usage(folder: pathlib.Path, entries: dict[str, zoo.Entry]) -> str:
 
 
 def contents(folder: pathlib.Path) -> RenderableType:
-  """The zoo's files (kind, size, records, path), how much they hold, then any problem of a
-  file against the manifest."""
+  """The zoo's files (kind, physics version, size, records, path), how much they hold, then any
+  problem of a file against the manifest."""
   entries = zoo.read_manifest(folder)
   rows = [
-    [entry.kind, f"{entry.bytes / KB:.1f}", str(len(entry.records)), path]
+    [entry.kind, entry.physics, f"{entry.bytes / KB:.1f}", str(len(entry.records)), path]
     for path, entry in sorted(entries.items())
   ]
   return Group(
-    terminal.table(("kind", "kB", "records", "path"), rows, right=("kB", "records")),
+    terminal.table(("kind", "physics", "kB", "records", "path"), rows, right=("kB", "records")),
     f"{len(entries)} files, {usage(folder, entries)}",
     *(f"problem: {problem}" for problem in zoo.check_files(folder)),
   )
