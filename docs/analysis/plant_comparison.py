@@ -10,7 +10,7 @@ proximal modules, tendon-local-3 acts within each module as the paper's simulato
 
 Usage:
   python docs/analysis/plant_comparison.py [--robots tendon-3 tendon-local-3] [--profile default]
-      [--eval physics] [--results leaderboard/results]
+      [--eval physics] [--results leaderboard/results] [--physics v0]
 """
 
 import argparse
@@ -44,8 +44,12 @@ def main() -> None:
   parser.add_argument("--profile", default="default")
   parser.add_argument("--eval", default="physics")
   parser.add_argument("--results", type=pathlib.Path, default=leaderboard.DEFAULT_RESULTS)
+  parser.add_argument(
+    "--physics", help="the records of this physics version (default: the newest among them)"
+  )
   args = parser.parse_args()
-  found = estimates(leaderboard.build(args.results), args.profile, args.eval)
+  board = leaderboard.build(args.results)
+  found = estimates(board.of_physics(args.physics or board.physics), args.profile, args.eval)
   tasks = [
     task
     for task in suite.TASKS
