@@ -128,7 +128,7 @@ def test_the_tables_use_the_records_population_std(board):
   smpl = (
     "| smpl | 11.50 ± 0.33 (4.97) | 2.74 ± 0.32 (2.77) | 2.84 ± 0.31 (2.38) | 2.51 ± 0.25 (3.02) |"
   )
-  assert smpl in doc_tables.render("overview-pneumatic-433-paper", board)
+  assert smpl in doc_tables.render("overview-pneumatic-433-paper@v0", board)
 
 
 def test_leaderboard_write_rewrites_the_blocks_of_the_checkout(tmp_path, capsys):
