@@ -15,6 +15,7 @@ from softbench import storage
 from softbench import zoo
 from softbench.agents import learned
 from softbench.records import fields as record_fields
+from softbench.robots import versions
 
 
 @dataclasses.dataclass(frozen=True)
@@ -141,8 +142,11 @@ def cache_files(chosen: Setting) -> list[tuple[int, pathlib.Path, str]]:
 
 
 def stands_behind(record: dict, chosen: Setting, seed: int) -> bool:
-  """Whether ``record`` is one of ``chosen``'s with a seed ``seed`` (healthy robot)."""
+  """Whether ``record`` is one of ``chosen``'s with a seed ``seed`` (healthy robot), simulated
+  with the installed physics version (the cache files' own)."""
   if record["profile"] != chosen.profile.name or seed >= record["seeds"]:
+    return False
+  if record_fields.physics_of(record) != versions.current().name:
     return False
   if chosen.family is not None:
     return (
