@@ -7,12 +7,14 @@ line with exit 2; records, cache keys and the zoo's verification keep the versio
 import hashlib
 import json
 import pathlib
+import shutil
 
 import pytest
 
 from softbench import cli
 from softbench import records
 from softbench import robots
+from softbench import zoo
 from softbench.records import fields as record_fields
 from softbench.records import provenance
 from softbench.robots import versions
@@ -90,8 +92,18 @@ def test_the_cable_backbone_is_refused_where_mujoco_lacks_the_plugin():
 
 
 @pytest.mark.skipif(versions.current().name == "v0", reason="the zoo's records are v0: verifiable")
-def test_zoo_verify_refuses_records_of_another_physics_in_one_line(capsys):
-  argv = ["zoo", "verify", "--quick", "--agents", "smpl", "--zoo", str(CHECKOUT / "zoo")]
+def test_zoo_verify_refuses_records_of_another_physics_in_one_line(tmp_path, capsys):
+  # A zoo of one v0 checkpoint of the repository's zoo, and the committed records.
+  repository = CHECKOUT / "zoo"
+  entry = next(
+    entry
+    for entry in zoo.read_manifest(repository).values()
+    if entry.kind == "agent" and entry.physics == "v0" and entry.records
+  )
+  (tmp_path / entry.path).parent.mkdir(parents=True)
+  shutil.copy(repository / entry.path, tmp_path / entry.path)
+  zoo.write_manifest(tmp_path, {entry.path: entry})
+  argv = ["zoo", "verify", "--quick", "--zoo", str(tmp_path)]
   assert cli.main([*argv, "--results", str(CHECKOUT / records.DEFAULT_FOLDER)]) == cli.EXIT_USAGE
   (line,) = capsys.readouterr().err.strip().splitlines()
   assert "cannot be re-scored on physics" in line and versions.VERSIONS["v0"].install in line
