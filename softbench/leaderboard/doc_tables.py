@@ -425,11 +425,11 @@ def _table_and_physics(name: str) -> tuple[str, str | None]:
   table, _, physics = name.partition(PHYSICS_SEPARATOR)
   if table not in TABLES:
     raise DocTableError(f"unknown table {table!r}; known: {', '.join(TABLES)}")
-  if physics and physics not in versions.VERSIONS:
-    raise DocTableError(
-      f"unknown physics version {physics!r} in table {name!r}; "
-      f"known: {', '.join(versions.VERSIONS)}"
-    )
+  if physics:
+    try:
+      versions.named(physics)
+    except ValueError as error:
+      raise DocTableError(f"{error} (table {name!r})") from None
   return table, physics or None
 
 

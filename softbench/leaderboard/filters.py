@@ -42,10 +42,7 @@ class RecordFilter:
     for profile in self.profiles:
       profile_registry.get(profile)
     for name in self.physics:
-      if name not in versions.VERSIONS:
-        raise ValueError(
-          f"unknown physics version {name!r}; choose from {', '.join(versions.VERSIONS)}"
-        )
+      versions.named(name)
 
   @property
   def active(self) -> bool:

@@ -41,7 +41,7 @@ def non_negative(maximum: float = MAX_ERROR) -> dict:
 PHYSICS_FIELD = "physics"
 """The physics version a record was simulated with (``softbench.robots.versions``); records made
 before there were versions (up to 2026-12-06) lack it and are v0."""
-PHYSICS_BEFORE_VERSIONS = "v0"
+PHYSICS_BEFORE_VERSIONS = versions.FIRST
 
 
 def physics_of(record: dict) -> str:

@@ -222,16 +222,16 @@ def add_chain(
   return built
 
 
-def add_torsion_actuators(spec: mujoco.MjSpec, rod: Chain) -> int:
+def add_torsion_actuators(spec: mujoco.MjSpec, rod: Chain) -> None:
   """Gives every ball joint of ``rod`` the torsion actuator that makes its twisting stiffness
-  G·J / l while its spring bends with E·I / l (see the module's docstring); returns how many
-  were added (none for a rod whose ``torsional_stiffness`` is None).
+  G·J / l while its spring bends with E·I / l (see the module's docstring); none for a rod whose
+  ``torsional_stiffness`` is None.
 
   Add them after the robot's own actuators, whose indices the action map and faults count.
   """
   joints = rod.joints
   if joints.torsional_stiffness is None:
-    return 0
+    return
   for body, origin, previous in zip(rod.bodies[1:], rod.origins[1:], rod.origins[:-1]):
     spacing = origin - previous
     softening = (joints.bending_stiffness - joints.torsional_stiffness) / spacing  # (N·m/rad)
@@ -246,7 +246,6 @@ def add_torsion_actuators(spec: mujoco.MjSpec, rod: Chain) -> int:
       biasprm=[0.0, softening] + [0.0] * 8,
       ctrllimited=mujoco.mjtLimited.mjLIMITED_FALSE,
     )
-  return len(rod.bodies) - 1
 
 
 def _add_rod_geom(

@@ -106,6 +106,17 @@ def cable_plugin_available() -> bool:
 _CABLE_PROBE = '<mujoco><extension><plugin plugin="mujoco.elasticity.cable"/></extension></mujoco>'
 
 
+def named(name: str) -> PhysicsVersion:
+  """The version called ``name``, installed or not.
+
+  Raises:
+    ValueError: no version has that name (one line).
+  """
+  if name not in VERSIONS:
+    raise ValueError(f"unknown physics version {name!r}; choose from {', '.join(VERSIONS)}")
+  return VERSIONS[name]
+
+
 def check(name: str) -> PhysicsVersion:
   """The version called ``name`` if this installation runs it.
 
@@ -113,9 +124,7 @@ def check(name: str) -> PhysicsVersion:
     ValueError: unknown name, or a version whose stack is not installed (one line, saying how to
       install it).
   """
-  if name not in VERSIONS:
-    raise ValueError(f"unknown physics version {name!r}; choose from {', '.join(VERSIONS)}")
-  version = VERSIONS[name]
+  version = named(name)
   if version != current():
     raise ValueError(
       f"physics {name} ({version.description}) needs {version.engine}, but MuJoCo "
