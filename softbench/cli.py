@@ -9,6 +9,7 @@ import argparse
 from collections.abc import Callable
 from collections.abc import Collection
 import dataclasses
+import difflib
 import os
 import pathlib
 import sys
@@ -65,7 +66,7 @@ def _models_export(args: argparse.Namespace) -> None:
   from softbench.robots import export as model_export
 
   out = storage.check_writable(args.out, "models to", folder=True)
-  chosen = [robots.make(name) for name in args.robots or robots.BENCHMARK_ROBOTS]  # Checked first.
+  chosen = [robots.make(name) for name in args.robots or robots.REGISTERED_ROBOTS]  # Checked first.
   for robot in chosen:
     for path in model_export.export(robot, out, args.measure_speed):
       print(path)
@@ -234,12 +235,19 @@ def _add_results_argument(
   parser.add_argument(
     "--results",
     default=str(records.DEFAULT_FOLDER),
-    help=f"{what} (default {records.DEFAULT_FOLDER})",
+    help=f"{what} (default {records.DEFAULT_FOLDER}, the committed leaderboard's)",
   )
 
 
 def _add_record_arguments(parser: argparse.ArgumentParser) -> None:
-  _add_results_argument(parser)
+  from softbench import records
+
+  parser.add_argument(
+    "--results",
+    help=f"folder to write the result record to (default $SOFTBENCH_HOME/"
+    f"{records.USER_FOLDER_NAME}, your own runs; the committed leaderboard's is "
+    f"{records.DEFAULT_FOLDER})",
+  )
   parser.add_argument("--json", help="also write the result record to this file")
   _add_physics_argument(parser)
 
@@ -270,7 +278,11 @@ def _json_copy(args: argparse.Namespace) -> pathlib.Path | None:
 def _check_record_arguments(args: argparse.Namespace) -> None:
   """Refuses a ``--physics`` this installation does not run, and a ``--results`` or ``--json``
   that could not be written, before the run."""
+  from softbench import records
+
   _check_physics(args)
+  if args.results is None:
+    args.results = str(records.user_folder())
   storage.check_writable(args.results, "result records to", folder=True)
   if args.json:
     storage.check_writable(args.json, "result record")
@@ -399,10 +411,33 @@ _FAULT_HELP = (
 
 class _OneLineErrorParser(argparse.ArgumentParser):
   """An argument parser (and, through ``add_subparsers``, its subcommands' parsers) whose
-  command-line errors are one line, pointing at ``--help`` instead of printing the usage."""
+  command-line errors are one line, pointing at the command's own ``--help`` (and at the option
+  meant, for a misspelt one) instead of printing the usage. Options are never abbreviated: run's
+  ``--seeds N`` (a count) must not answer to render's ``--seed K`` (which seed)."""
+
+  def __init__(self, *args, **kwargs):
+    super().__init__(*args, allow_abbrev=False, **kwargs)
+    self.command_parsers: dict[str, "_OneLineErrorParser"] = {}
 
   def error(self, message: str):
     self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+  def parse_args(self, args=None, namespace=None):
+    """Parses like ``argparse``, but an argument no parser took is the command's error."""
+    parsed, unknown = self.parse_known_args(args, namespace)
+    if unknown:
+      command = self.command_parsers.get(getattr(parsed, "command", None), self)
+      command.error(f"unrecognized arguments: {' '.join(unknown)}{command.suggestion(unknown)}")
+    return parsed
+
+  def suggestion(self, unknown: list[str]) -> str:
+    """'; did you mean --seeds?' for the first unknown option close to one of this parser's."""
+    known = [option for action in self._actions for option in action.option_strings]
+    for word in unknown:
+      close = difflib.get_close_matches(word.partition("=")[0], known, n=1, cutoff=0.75)
+      if word.startswith("--") and close:
+        return f"; did you mean {close[0]}?"
+    return ""
 
 
 def _robots_arguments(parser: argparse.ArgumentParser) -> None:
@@ -772,7 +807,7 @@ def _models_arguments(parser: argparse.ArgumentParser) -> None:
     "--robots",
     nargs="+",
     metavar="ROBOT",
-    help="export only these robots (default: every benchmark robot)",
+    help="export only these robots (default: every registered robot)",
   )
   export_parser.add_argument(
     "--measure-speed", action="store_true", help="also measure simulation speed into speed.json"
@@ -793,7 +828,7 @@ class _Command:
 
 
 _COMMANDS = {
-  "robots": _Command("list the benchmark robots or describe one", _robots_arguments, _robots),
+  "robots": _Command("list the registered robots or describe one", _robots_arguments, _robots),
   "tasks": _Command("list the tasks of the suite", _tasks_arguments, _tasks),
   "collect": _Command(
     "record (or resume) a motor-babbling dataset",
@@ -873,6 +908,7 @@ def build_parser(commands: Collection[str] = tuple(_COMMANDS)) -> argparse.Argum
   subparsers = parser.add_subparsers(dest="command", required=True)
   for name, entry in _COMMANDS.items():
     command_parser = subparsers.add_parser(name, help=entry.help, description=entry.description)
+    parser.command_parsers[name] = command_parser
     if name in commands:
       entry.add_arguments(command_parser)
       if entry.run is not None:

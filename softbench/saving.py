@@ -3,9 +3,9 @@
 A runner (``softbench.run``, ``softbench.continual``, ``softbench.retrain``) returns a record from
 its ``execute`` and offers ``table(record)`` and ``record_path(record, results)``; ``save`` prints
 the table, writes the record (checked, sealed and atomic: ``records.write``) under the results
-folder and to an extra copy if asked, and says where. What only one runner does afterwards (its
-plots, a video, discarding the finished seeds it kept for resuming) follows, once the record is
-safe.
+folder (by default the user's own, ``records.user_folder()``) and to an extra copy if asked, and
+says where and how to rank it. What only one runner does afterwards (its plots, a video,
+discarding the finished seeds it kept for resuming) follows, once the record is safe.
 """
 
 import os
@@ -32,6 +32,8 @@ def save(
   path = runner.record_path(record, results)
   records.write(record, path)
   print(f"result record: {path}")
+  if pathlib.Path(results).resolve() != records.DEFAULT_FOLDER.resolve():
+    print(f"rank your runs: softbench leaderboard --results {results}")
   if copy is not None:
     records.write(record, copy)
   return [path] + ([copy] if copy is not None else [])

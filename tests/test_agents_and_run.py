@@ -17,6 +17,7 @@ from softbench import evaluation
 from softbench import parallel_seeds
 from softbench import profiles
 from softbench import protocols
+from softbench import records
 from softbench import robots
 from softbench import run
 from softbench import storage
@@ -507,3 +508,18 @@ def test_an_unstable_simulation_is_one_line(capsys, tmp_path, monkeypatch):
     "(Physics state is invalid. Warning(s) raised: "
     "mjWARN_BADQACC)"
   )
+
+
+def test_a_run_writes_its_record_to_the_data_home_not_the_checkout(tmp_path, monkeypatch, capsys):
+  # make run, then make test: what a user's run writes must not change the committed records.
+  checkout_results = tmp_path / "checkout" / records.DEFAULT_FOLDER
+  checkout_results.mkdir(parents=True)
+  monkeypatch.chdir(tmp_path / "checkout")
+  argv = ["run", "--task", "circle", "--agent", "zero", "--robot", "tendon-1", "--seeds", "1"]
+  assert cli.main([*argv, "--profile", "tiny", "--workers", "1"]) == 0
+  assert list(checkout_results.iterdir()) == []
+  written = list(records.user_folder().glob("*.json"))
+  assert len(written) == 1 and written[0].parent == storage.softbench_home() / "results"
+  out = capsys.readouterr().out
+  assert f"result record: {written[0]}" in out
+  assert f"rank your runs: softbench leaderboard --results {records.user_folder()}" in out

@@ -26,7 +26,7 @@ from softbench.robots.physics import SoftArmPhysics
 MODELS = pathlib.Path(__file__).resolve().parents[1] / "models"
 
 
-@pytest.mark.parametrize("name", robots.BENCHMARK_ROBOTS)
+@pytest.mark.parametrize("name", robots.REGISTERED_ROBOTS)
 def test_committed_models_are_identical_to_regenerated(name):
   for file_name, text in export.model_files(robots.make(name)).items():
     assert (MODELS / name / file_name).read_text() == text, file_name
@@ -41,18 +41,18 @@ def test_committed_model_readme_is_identical_to_regenerated(name):
   assert (MODELS / name / "README.md").read_text() == export.readme(robots.make(name), speed)
 
 
-def test_cli_export_writes_every_benchmark_model(tmp_path, monkeypatch):
+def test_cli_export_writes_every_registered_model(tmp_path, monkeypatch):
   monkeypatch.setattr(export, "readme", lambda robot, speed: f"# {robot.name}\n")
   assert cli.main(["models", "export", "--out", str(tmp_path)]) == 0
   written = sorted(str(p.relative_to(tmp_path)) for p in tmp_path.rglob("*") if p.is_file())
   assert written == sorted(
     f"{name}/{file}"
-    for name in robots.BENCHMARK_ROBOTS
+    for name in robots.REGISTERED_ROBOTS
     for file in (f"{name}.xml", "scene.xml", "README.md")
   )
 
 
-@pytest.mark.parametrize("name", robots.BENCHMARK_ROBOTS)
+@pytest.mark.parametrize("name", robots.REGISTERED_ROBOTS)
 def test_exported_scene_compiles(name):
   model = mujoco.MjModel.from_xml_path(str(MODELS / name / "scene.xml"))
   assert model.nu == len(robots.make(name).actuator_maps())
@@ -63,7 +63,7 @@ def test_exported_scene_compiles(name):
   "name",
   [
     name
-    for name in robots.BENCHMARK_ROBOTS
+    for name in robots.REGISTERED_ROBOTS
     if name.startswith("tendon-local-") and robots.make(name).num_modules >= 3
   ],
 )
@@ -82,17 +82,51 @@ def test_exported_local_arm_bends_only_the_pulled_module(name):
   assert turned[0] <= 1.0 and turned[2] >= 45.0, turned
 
 
-def test_cli_lists_every_benchmark_robot(capsys):
+def test_cli_lists_every_registered_robot_and_names_the_leaderboards(capsys):
   assert cli.main(["robots"]) == 0
-  rows = capsys.readouterr().out.splitlines()[1:]
-  assert [row.split()[0] for row in rows] == list(robots.BENCHMARK_ROBOTS)
+  table, footer = capsys.readouterr().out.split("\n\n")
+  rows = table.splitlines()[1:]
+  assert [row.split()[0] for row in rows] == list(robots.REGISTERED_ROBOTS)
   assert rows[0].split()[1:3] == ["1", "2"]  # tendon-1: one module, two action entries.
+  assert footer.startswith(f"{len(rows)} registered robots")
+  assert footer.strip().endswith("ranks agents on tendon-3, tendon-local-3, pneumatic-433")
+
+
+@pytest.mark.parametrize(
+  "argv,line",
+  [
+    (
+      ["run", "--task", "spiral", "--agent", "zero", "--seed", "2"],
+      "softbench run: error: unrecognized arguments: --seed 2; did you mean --seeds? "
+      "(see softbench run --help)",
+    ),
+    (
+      ["render", "--task", "spiral", "--agent", "zero", "--seeds", "2", "--out", "x.mp4"],
+      "softbench render: error: unrecognized arguments: --seeds 2; did you mean --seed? "
+      "(see softbench render --help)",
+    ),
+    (
+      ["run", "--task", "spiral", "--agent", "zero", "--prof", "tiny"],  # No abbreviations.
+      "softbench run: error: unrecognized arguments: --prof tiny; did you mean --profile? "
+      "(see softbench run --help)",
+    ),
+    (
+      ["leaderboard", "--robot", "tendon-3"],
+      "softbench leaderboard: error: unrecognized arguments: --robot tendon-3; did you mean "
+      "--robots? (see softbench leaderboard --help)",
+    ),
+  ],
+)
+def test_an_unknown_option_is_the_commands_error_with_the_option_meant(argv, line, capsys):
+  assert cli.main(argv) == cli.EXIT_USAGE
+  captured = capsys.readouterr()
+  assert captured.out == "" and captured.err == line + "\n"
 
 
 def test_cli_lists_robots_tasks_and_agents_as_json(capsys):
   assert cli.main(["robots", "--json"]) == 0
   listed = json.loads(capsys.readouterr().out)
-  assert [robot["name"] for robot in listed] == list(robots.BENCHMARK_ROBOTS)
+  assert [robot["name"] for robot in listed] == list(robots.REGISTERED_ROBOTS)
   for facts in listed:
     arm = robots.make(facts["name"])
     assert facts["action_dim"] == arm.action_dim == sum(facts["actuators_per_module"])
@@ -103,7 +137,7 @@ def test_cli_lists_robots_tasks_and_agents_as_json(capsys):
   assert cli.main(["tasks", "--json"]) == 0
   tasks = json.loads(capsys.readouterr().out)
   assert [task["name"] for task in tasks] == list(suite.TASKS)
-  pairs = {(robot, task["name"]) for task in tasks for robot in task["benchmark_robots"]}
+  pairs = {(robot, task["name"]) for task in tasks for robot in task["registered_robots"]}
   assert pairs == set(suite.ALL_TASKS)
   assert cli.main(["agents", "--json"]) == 0
   listed_agents = json.loads(capsys.readouterr().out)

@@ -38,7 +38,9 @@ from softbench.records import exp1s as exp1s_records
 from softbench.records import fields as record_fields
 from softbench.records.fields import METRICS
 
-DEFAULT_FOLDER = pathlib.Path("leaderboard/results")  # Where softbench run writes records.
+DEFAULT_FOLDER = pathlib.Path("leaderboard/results")  # The committed leaderboard's records
+# (a checkout's): what softbench leaderboard, sweep and zoo read by default.
+USER_FOLDER_NAME = "results"  # In the data home: where softbench run writes by default.
 FORMAT = "softbench-result"
 VERSION = 2
 INTEGRITY_FIELD = record_fields.INTEGRITY_FIELD
@@ -57,6 +59,13 @@ _OPTIONAL_FIELDS = (
 ADAPTIVE_SECTION = "adaptive"  # softbench run --adaptive: per-target results, no per-seed ones.
 _MEAN_TOLERANCE = 1e-9  # Relative: a seed's mean against the mean of its per-module values.
 _MAX_MESSAGE_CHARS = 160  # Of a schema error's message, so that a refusal stays one line.
+
+
+def user_folder() -> pathlib.Path:
+  """Where ``softbench run`` and ``retrain`` write records by default: ``results`` in the data
+  home, the user's own runs, apart from the committed leaderboard (``DEFAULT_FOLDER``), so that
+  a run changes nothing in a checkout."""
+  return storage.softbench_home() / USER_FOLDER_NAME
 
 
 class RecordError(ValueError):
