@@ -37,7 +37,31 @@ def _received(states) -> Iterator[tuple]:
 
 
 class WorkerDied(RuntimeError):
-  """A worker process ended without a result (killed, or out of memory)."""
+  """A worker process ended without a result; the message says how (signal or exit code)."""
+
+
+# What a worker's death by a signal most likely means (the kernel's OOM killer sends SIGKILL).
+_SIGNAL_CAUSES = {
+  signal.SIGKILL: "killed, or out of memory",
+  signal.SIGSEGV: "a crash in native code; docs/install.md",
+  signal.SIGBUS: "a crash in native code, or a full /dev/shm",
+  signal.SIGABRT: "aborted by native code",
+}
+
+
+def how_workers_ended(executor: futures.ProcessPoolExecutor) -> str:
+  """How the worker that broke ``executor`` ended: 'was killed by SIGSEGV (...)', 'exited with
+  code 3'. The pool terminates the others (SIGTERM), so a worker that ended otherwise is the
+  one."""
+  codes = [process.exitcode for process in (executor._processes or {}).values() if process.exitcode]
+  code = next((code for code in codes if code != -signal.SIGTERM), codes[0] if codes else None)
+  if code is None:
+    return "ended without a result"
+  if code > 0:
+    return f"exited with code {code}"
+  killer = signal.Signals(-code)
+  cause = _SIGNAL_CAUSES.get(killer)
+  return f"was killed by {killer.name}" + (f" ({cause})" if cause else "")
 
 
 def in_processes(function, arguments: list[tuple], label: str, workers: int) -> list:
@@ -75,10 +99,10 @@ def in_processes(function, arguments: list[tuple], label: str, workers: int) -> 
       outcomes = [future.result() for future in pending]  # Re-raises a worker's error.
       progress.update(bar, completed=len(arguments))
   except futures.process.BrokenProcessPool:
+    how = how_workers_ended(executor)
     _terminate(executor)
     raise WorkerDied(
-      f"a worker process of {label} ended without a result (killed, or out of "
-      f"memory?); run the same command again to resume"
+      f"a worker process of {label} {how}; run the same command again to resume"
     ) from None
   except BaseException:  # A worker's error, or Ctrl-C: the other workers stop at once.
     _terminate(executor)

@@ -1,9 +1,13 @@
 """Packaging: compatible ranges in the metadata, exact versions in the constraints file that the
-README's commands install with, the licence and citation files, and the version."""
+README's commands install with, the licence and citation files, the version, and native
+libraries loaded in an order that works (triton before EGL)."""
 
+import importlib.util
+import os
 import pathlib
 import re
 import subprocess
+import sys
 
 from packaging import requirements
 from packaging import utils
@@ -96,3 +100,50 @@ def test_licence_citation_and_version_agree():
 def test_version_flag(capsys):
   assert cli.main(["--version"]) == 0
   assert capsys.readouterr().out == f"softbench {softbench.__version__}\n"
+
+
+# A stand-in for triton's native library: it fails where Mesa's EGL is loaded already (dm_control
+# loads it when imported with MUJOCO_GL=egl), where the real one crashes the process.
+_FAKE_TRITON_LIBRARY = """
+import sys
+if "dm_control.mujoco" in sys.modules:
+  raise SystemExit("triton loaded after EGL")
+print("triton loaded first")
+"""
+
+
+@pytest.fixture
+def fake_triton(tmp_path) -> dict:
+  """The environment of a child process that finds a stand-in for triton and renders with EGL."""
+  (tmp_path / "triton" / "_C").mkdir(parents=True)
+  (tmp_path / "triton" / "__init__.py").write_text("")
+  (tmp_path / "triton" / "_C" / "__init__.py").write_text("")
+  (tmp_path / "triton" / "_C" / "libtriton.py").write_text(_FAKE_TRITON_LIBRARY)
+  return {**os.environ, "MUJOCO_GL": "egl", "PYTHONPATH": str(tmp_path)}
+
+
+@pytest.mark.parametrize("program", ["import softbench.suite", "import softbench.envs"])
+def test_softbench_loads_triton_before_egl(program, fake_triton):
+  child = [sys.executable, "-c", f"{program}; import dm_control.mujoco; import triton._C.libtriton"]
+  result = subprocess.run(child, env=fake_triton, capture_output=True, text=True, timeout=120)
+  assert result.returncode == 0 and result.stdout.count("triton loaded first") == 1, result
+
+
+def test_dm_control_imported_first_is_one_warning_not_a_crash(fake_triton):
+  child = [sys.executable, "-c", "import dm_control.mujoco; import softbench"]
+  result = subprocess.run(child, env=fake_triton, capture_output=True, text=True, timeout=120)
+  assert result.returncode == 0 and "triton loaded" not in result.stdout, result
+  assert "loading triton now would crash the process" in result.stderr, result
+
+
+@pytest.mark.skipif(
+  importlib.util.find_spec("triton") is None,
+  reason="triton is not installed: the CPU build of torch (constraints.txt) comes without it",
+)
+def test_the_real_triton_and_egl_live_in_one_process():
+  # Without softbench's order: MUJOCO_GL=egl python -c "import dm_control.mujoco; import triton"
+  # ends in SIGSEGV (triton 3.9.0, Mesa's EGL, 2026-12-06).
+  child = [sys.executable, "-c", "import softbench.suite, dm_control.mujoco, triton, torch._dynamo"]
+  environment = {**os.environ, "MUJOCO_GL": "egl"}
+  result = subprocess.run(child, env=environment, capture_output=True, text=True, timeout=300)
+  assert result.returncode == 0, result

@@ -30,6 +30,10 @@ def die(value):
   os._exit(3)
 
 
+def crash(value):
+  os.kill(os.getpid(), signal.SIGSEGV)
+
+
 def test_results_come_back_in_order_from_workers_of_one_torch_thread():
   # Torch's default is one thread per core in every worker, which oversubscribes the cores.
   assert parallel_seeds.in_processes(
@@ -76,19 +80,26 @@ from softbench import parallel_seeds
 from softbench import progress
 import test_parallel_seeds
 try:
-  parallel_seeds.in_processes(test_parallel_seeds.die, [(1,), (2,)], "dying", workers=2)
+  parallel_seeds.in_processes(test_parallel_seeds.{dying}, [(1,), (2,)], "dying", workers=2)
 except parallel_seeds.WorkerDied as error:
   print("reported:", error)
 """
 
 
-def test_a_dead_worker_is_reported_not_waited_for():
+@pytest.mark.parametrize(
+  "dying,how",
+  [
+    ("die", "dying exited with code 3;"),
+    ("crash", "dying was killed by SIGSEGV (a crash in native code; docs/install.md);"),
+  ],
+)
+def test_a_dead_worker_is_reported_with_how_it_ended_not_waited_for(dying, how):
   # In a child with a deadline: a hang fails the test (TimeoutExpired) instead of the suite.
-  program = _DYING_PROGRAM.format(tests=os.path.dirname(__file__))
+  program = _DYING_PROGRAM.format(tests=os.path.dirname(__file__), dying=dying)
   result = subprocess.run(
     [sys.executable, "-c", program], capture_output=True, text=True, timeout=CHILD_DEADLINE_S
   )
-  assert "reported:" in result.stdout and "ended without a result" in result.stdout, result
+  assert f"reported: a worker process of {how}" in result.stdout, result
 
 
 _INTERRUPTED_PROGRAM = """
