@@ -12,7 +12,7 @@ _STEPS = 4  # Control steps of the loaded episode: loading, not stepping, is mea
 _CALIBRATION_ROUNDS = 3
 
 
-@pytest.mark.parametrize("name", robots.BENCHMARK_ROBOTS)
+@pytest.mark.parametrize("name", robots.REGISTERED_ROBOTS)
 def test_task_load_seconds(benchmark, tmp_path, monkeypatch, name):
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
   suite.load(name, "circle", length=_STEPS)  # Simulates and caches the reference once.

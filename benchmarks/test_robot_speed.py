@@ -13,7 +13,7 @@ from softbench import robots
 _SIMULATED_SECONDS = 2.0  # (s) Simulated time per benchmark round, under random actuation.
 
 
-@pytest.mark.parametrize("name", robots.BENCHMARK_ROBOTS)
+@pytest.mark.parametrize("name", robots.REGISTERED_ROBOTS)
 def test_physics_steps_per_second(benchmark, name):
   robot = robots.make(name)
   model = robot.compile()

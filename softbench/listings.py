@@ -29,18 +29,23 @@ def robot_facts(robot: robots.SoftArm) -> dict:
 
 
 def robots_document(name: str | None = None, **overrides) -> list[dict] | dict:
-  """The facts of every benchmark robot, or of robot ``name`` with its spec; ``overrides`` change
+  """The facts of every registered robot, or of robot ``name`` with its spec; ``overrides`` change
   the spec (``robots.make``)."""
   if name is None:
-    return [robot_facts(robots.make(listed, **overrides)) for listed in robots.BENCHMARK_ROBOTS]
+    return [robot_facts(robots.make(listed, **overrides)) for listed in robots.REGISTERED_ROBOTS]
   robot = robots.make(name, **overrides)
   return {**robot_facts(robot), "spec": dict(model_export.spec_fields(robot))}
 
 
 def robots_table(name: str | None = None, **overrides) -> RenderableType:
-  """Every benchmark robot, one row each; or robot ``name``'s row, control period and spec."""
+  """Every registered robot, one row each; or robot ``name``'s row, control period and spec."""
   if name is None:
-    return _robot_rows([robots.make(listed, **overrides) for listed in robots.BENCHMARK_ROBOTS])
+    return Group(
+      _robot_rows([robots.make(listed, **overrides) for listed in robots.REGISTERED_ROBOTS]),
+      "",
+      f"{len(robots.REGISTERED_ROBOTS)} registered robots (any tendon arm of 1 to 10 modules "
+      f"also builds); the leaderboard ranks agents on {', '.join(robots.LEADERBOARD_ROBOTS)}",
+    )
   robot = robots.make(name, **overrides)
   return Group(
     _robot_rows([robot]),
@@ -66,13 +71,13 @@ def _robot_rows(listed: list[robots.SoftArm]) -> RenderableType:
 
 
 def tasks_document() -> list[dict]:
-  """Every task: its tags, description and the benchmark robots it is scored on."""
+  """Every task: its tags, description and the registered robots it is scored on."""
   return [
     {
       "name": task,
       "tags": list(suite.describe(task).tags),
       "description": suite.describe(task).description,
-      "benchmark_robots": [robot for robot, name in suite.ALL_TASKS if name == task],
+      "registered_robots": [robot for robot, name in suite.ALL_TASKS if name == task],
     }
     for task in suite.TASKS
   ]
@@ -85,7 +90,7 @@ def tasks_table() -> RenderableType:
     for task in suite.TASKS
   ]
   periods = sorted(
-    {(robots.make(name).control_timestep, name.split("-")[0]) for name in robots.BENCHMARK_ROBOTS},
+    {(robots.make(name).control_timestep, name.split("-")[0]) for name in robots.REGISTERED_ROBOTS},
     key=lambda item: item[1],
   )
   return Group(
@@ -93,8 +98,9 @@ def tasks_table() -> RenderableType:
     "",
     "control period: "
     + "; ".join(f"{family} arms {period:g} s ({1 / period:g} Hz)" for period, family in periods),
-    f"{len(suite.ALL_TASKS)} (robot, task) pairs on the benchmark robots "
-    f"({', '.join(robots.BENCHMARK_ROBOTS)}); every task runs on any robot",
+    f"{len(suite.ALL_TASKS)} (robot, task) pairs on the registered robots "
+    f"({', '.join(robots.REGISTERED_ROBOTS)}); every task runs on any robot; the leaderboard "
+    f"scores the benchmarking tasks on {', '.join(robots.LEADERBOARD_ROBOTS)}",
   )
 
 

@@ -1,5 +1,5 @@
 """Properties of the agents that need no training (in the registry: ``zero``, ``random`` and the
-model-based ``reference``), on every benchmark robot.
+model-based ``reference``), on every registered robot.
 
 Episodes are tiny (3 reach steps, the first 10 steps of a 100-step circle) so that the file runs
 in well under a minute; the properties do not depend on the length.
@@ -89,7 +89,7 @@ def tip_error_percent(
 
 @pytest.mark.parametrize("name", UNTRAINED_AGENTS)
 class TestEveryAgent:
-  @pytest.mark.parametrize("robot", robots.BENCHMARK_ROBOTS)
+  @pytest.mark.parametrize("robot", robots.REGISTERED_ROBOTS)
   def test_actions_are_finite_in_bounds_and_leave_the_physics(self, name, robot):
     episode = reach_episode(name, robot)
     assert episode.actions.shape == (REACH_STEPS, robots.make(robot).action_dim)

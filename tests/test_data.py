@@ -136,7 +136,7 @@ def test_random_streams_are_independent_and_reproducible():
   assert not np.array_equal(draw(0, data.BABBLING_STREAM, 0), draw(0, data.BABBLING_STREAM, 1))
 
 
-@pytest.mark.parametrize("robot_name", robots.BENCHMARK_ROBOTS)
+@pytest.mark.parametrize("robot_name", robots.REGISTERED_ROBOTS)
 def test_tiny_collection_of_every_robot(robot_name):
   collected = data.collect(robot_name, samples=6, episode_length=3, progress=False)
   arm = robots.make(robot_name)
@@ -407,7 +407,7 @@ def _views(arm):
   ]
 
 
-@pytest.mark.parametrize("robot_name", robots.BENCHMARK_ROBOTS)
+@pytest.mark.parametrize("robot_name", robots.REGISTERED_ROBOTS)
 def test_view_sizes_for_every_robot(robot_name):
   arm = robots.make(robot_name)
   end_effector, whole_arm, *modules = _views(arm)
@@ -427,7 +427,7 @@ def test_view_sizes_for_every_robot(robot_name):
     data.View.module(arm, arm.num_modules + 1)
 
 
-@pytest.mark.parametrize("robot_name", robots.BENCHMARK_ROBOTS)
+@pytest.mark.parametrize("robot_name", robots.REGISTERED_ROBOTS)
 def test_window_shapes_for_every_robot(robot_name):
   arm = robots.make(robot_name)
   collected = data.collect(robot_name, samples=20, episode_length=10, progress=False)

@@ -50,7 +50,7 @@ def make(robot, task, **options):
 def test_every_pair_of_the_suite_is_registered_under_its_id():
   ids = set(softbench.envs.env_ids())
   assert {softbench.envs.env_id(robot, task) for robot, task in suite.ALL_TASKS} <= ids
-  assert len(ids) == len(robots.BENCHMARK_ROBOTS) * len(suite.TASKS)
+  assert len(ids) == len(robots.REGISTERED_ROBOTS) * len(suite.TASKS)
   assert all(gymnasium.spec(env_id).entry_point == softbench.envs.ENTRY_POINT for env_id in ids)
 
 
@@ -156,7 +156,7 @@ def test_any_robot_and_fault_through_the_generic_id():
   assert np.linalg.norm(tips[0] - tips[1]) > 1e-3  # (m) The fault changes the physics.
 
 
-@pytest.mark.parametrize("robot", robots.BENCHMARK_ROBOTS)
+@pytest.mark.parametrize("robot", robots.REGISTERED_ROBOTS)
 def test_rgb_array_frames_show_the_arm_headlessly(robot):
   env = make(robot, "reach", render_mode="rgb_array", width=96, height=64)
   env.reset(seed=0)

@@ -1,4 +1,4 @@
-"""Actuator faults: the physics they specify on every benchmark robot, their parsing, evaluation
+"""Actuator faults: the physics they specify on every registered robot, their parsing, evaluation
 under a fault (``softbench run --fault``) and retraining one SMPL column (``softbench retrain``)."""
 
 import json
@@ -52,7 +52,7 @@ def _actuator_forces(model: mujoco.MjModel, qpos, qvel, ctrl) -> np.ndarray:
   return data.actuator_force.copy()
 
 
-@pytest.mark.parametrize("name", robots.BENCHMARK_ROBOTS)
+@pytest.mark.parametrize("name", robots.REGISTERED_ROBOTS)
 def test_a_fault_scales_exactly_its_actuator_and_nothing_else(name):
   healthy = robots.make(name)
   faulty = healthy.with_faults(_test_faults(healthy))
@@ -87,7 +87,7 @@ def test_a_fault_scales_exactly_its_actuator_and_nothing_else(name):
   np.testing.assert_array_equal(raw["faulty"][others], raw["healthy"][others])
 
 
-@pytest.mark.parametrize("name", robots.BENCHMARK_ROBOTS)
+@pytest.mark.parametrize("name", robots.REGISTERED_ROBOTS)
 def test_the_faulty_mjcf_differs_only_in_the_faulty_gains(name):
   healthy = robots.make(name)
   faulty = healthy.with_faults(_test_faults(healthy))
@@ -100,7 +100,7 @@ def test_the_faulty_mjcf_differs_only_in_the_faulty_gains(name):
   assert strip(healthy_xml) == strip(faulty_xml)
 
 
-@pytest.mark.parametrize("name", robots.BENCHMARK_ROBOTS)
+@pytest.mark.parametrize("name", robots.REGISTERED_ROBOTS)
 def test_gain_one_gives_an_identical_model(name):
   healthy = robots.make(name)
   whole = healthy.with_faults(

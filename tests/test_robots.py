@@ -1,6 +1,6 @@
 """Property tests over every robot of the registry (dm_control ``suite_test`` style).
 
-Every test that takes ``robot_name`` runs once per entry of ``BENCHMARK_ROBOTS``, so a new robot
+Every test that takes ``robot_name`` runs once per entry of ``REGISTERED_ROBOTS``, so a new robot
 is covered without new code. Physics runs through ``SoftArmPhysics`` (the class controllers use,
 built from the exported XML), but is stepped with ``mujoco.mj_step(model, data, nstep=...)`` on
 its raw structs rather than dm_control's Python step loop, for speed.
@@ -15,8 +15,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from softbench.robots import BENCHMARK_ROBOTS
 from softbench.robots import MAX_MODULES
+from softbench.robots import REGISTERED_ROBOTS
 from softbench.robots import TENDON_FAMILIES
 from softbench.robots import make
 from softbench.robots import measure
@@ -54,7 +54,7 @@ RETURN_TOLERANCE = 1e-3  # (m)
 # is symmetric, so the arms, still moving at 1 s, need not have reached equilibrium.
 MIRROR_SETTLE_S = 1.0
 MIRROR_TOLERANCE = 1e-6
-# Bend angles after 2 s and after 5 s of settling agree to 0.01 degree on every benchmark robot
+# Bend angles after 2 s and after 5 s of settling agree to 0.01 degree on every registered robot
 # (measured 2026-12-03), while consecutive actuation levels are 7 degrees or more apart.
 BEND_SETTLE_S = 2.0
 BEND_LEVELS = (0.2, 0.4, 0.6, 0.8, 1.0)
@@ -75,7 +75,7 @@ def _expected_size(name: str) -> tuple[int, int]:
 
 
 def _robots(xfail: dict[str, str] | None = None) -> list:
-  """``BENCHMARK_ROBOTS`` as pytest params; ``xfail`` maps a name to a known, measured failure."""
+  """``REGISTERED_ROBOTS`` as pytest params; ``xfail`` maps a name to a known, measured failure."""
   xfail = xfail or {}
   return [
     pytest.param(
@@ -83,7 +83,7 @@ def _robots(xfail: dict[str, str] | None = None) -> list:
       id=name,
       marks=[pytest.mark.xfail(strict=True, reason=xfail[name])] if name in xfail else [],
     )
-    for name in BENCHMARK_ROBOTS
+    for name in REGISTERED_ROBOTS
   ]
 
 
@@ -290,7 +290,7 @@ def test_bending_grows_with_actuation(robot_name):
 def _multi_module_tendon_arms() -> list:
   return [
     pytest.param(name, id=name)
-    for name in BENCHMARK_ROBOTS
+    for name in REGISTERED_ROBOTS
     if tendon_family(name) and make(name).num_modules > 1
   ]
 
@@ -460,9 +460,9 @@ def _module_twist_compliance(model: mujoco.MjModel, module: int) -> float:
 
 # Every backbone the robots build: the tendon arms' rod (ball springs and torsion actuators) and,
 # where MuJoCo 3 is installed, their cable plugin; the pneumatic arm's ball and slide springs.
-_BACKBONES = [pytest.param(name, {}, id=name) for name in BENCHMARK_ROBOTS] + [
+_BACKBONES = [pytest.param(name, {}, id=name) for name in REGISTERED_ROBOTS] + [
   pytest.param(name, {"backbone": backbone}, id=f"{name}-{backbone}")
-  for name in BENCHMARK_ROBOTS
+  for name in REGISTERED_ROBOTS
   if name.startswith("tendon-")
   for backbone in TENDON_BACKBONES
   if backbone != versions.current().backbone

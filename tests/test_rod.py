@@ -174,7 +174,7 @@ def test_the_rod_twists_with_g_j_and_bends_with_e_i(name):
     data.qpos[:] = model.qpos0
 
 
-@pytest.mark.parametrize("name", robots.BENCHMARK_ROBOTS)
+@pytest.mark.parametrize("name", robots.REGISTERED_ROBOTS)
 def test_no_benchmark_robot_needs_a_plugin_with_the_rod(name):
   spec = robots.make(name, **({"backbone": "rod"} if robots.tendon_family(name) else {}))
   xml = spec.to_xml()

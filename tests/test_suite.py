@@ -1,4 +1,4 @@
-"""Properties of every task on every benchmark robot, in the style of dm_control's suite_test.
+"""Properties of every task on every registered robot, in the style of dm_control's suite_test.
 
 Episodes are shortened (``length``/``steps``) so that the whole file runs in well under a minute;
 the properties do not depend on the length.
@@ -23,8 +23,8 @@ from softbench.robots import recorder
 from softbench.suite import references
 
 SHORT_STEPS = 3  # Control steps of every shortened episode; short_env gives `custom` 3 targets.
-# Every task on every benchmark robot: ALL_TASKS, plus the user's `custom` task.
-EVERY_TASK = tuple((robot, task) for robot in robots.BENCHMARK_ROBOTS for task in suite.TASKS)
+# Every task on every registered robot: ALL_TASKS, plus the user's `custom` task.
+EVERY_TASK = tuple((robot, task) for robot in robots.REGISTERED_ROBOTS for task in suite.TASKS)
 FAMILY_EXAMPLES = {family.example for family in robots.FAMILIES}
 
 
@@ -111,7 +111,7 @@ def test_the_same_seeds_on_a_new_environment_repeat_the_episode(robot, task):
       np.testing.assert_array_equal(first[name], second[name])
 
 
-@pytest.mark.parametrize("robot", robots.BENCHMARK_ROBOTS)
+@pytest.mark.parametrize("robot", robots.REGISTERED_ROBOTS)
 @pytest.mark.parametrize("shape", references.SHAPES)
 def test_every_reference_is_reachable(robot, shape):
   """Replaying a reference's generating actions from rest reproduces its poses exactly."""
@@ -125,7 +125,7 @@ def test_every_reference_is_reachable(robot, shape):
   np.testing.assert_allclose(np.array(achieved), reference.targets, rtol=0, atol=1e-12)
 
 
-@pytest.mark.parametrize("robot", robots.BENCHMARK_ROBOTS)
+@pytest.mark.parametrize("robot", robots.REGISTERED_ROBOTS)
 def test_bend_amplitude_bends_the_end_effector_by_the_stated_angle(robot):
   arm = robots.make(robot)
   amplitude = references.bend_amplitude(arm)
@@ -345,7 +345,7 @@ def test_bad_arguments_get_one_line_errors(call, message):
 
 def test_registry_lists():
   assert set(suite.TASKS) == {"babbling", "circle", "rectangle", "spiral", "reach", "custom"}
-  assert len(suite.ALL_TASKS) == len(robots.BENCHMARK_ROBOTS) * 5
+  assert len(suite.ALL_TASKS) == len(robots.REGISTERED_ROBOTS) * 5
   assert set(suite.BENCHMARKING) <= set(suite.ALL_TASKS)
   assert ("tendon-3", "spiral") in suite.BENCHMARKING
 

@@ -41,7 +41,7 @@ def test_a_record_without_physics_is_v0():
   assert record_fields.physics_of({"agent": "zero"}) == "v0"
 
 
-@pytest.mark.parametrize("name", robots.BENCHMARK_ROBOTS)
+@pytest.mark.parametrize("name", robots.REGISTERED_ROBOTS)
 def test_cache_keys_name_the_physics(name):
   # v0 keeps the hash of the MJCF alone (the zoo's v0 files still answer there); later versions
   # add their name, so that the pneumatic arm, whose MJCF is the same on both, keys apart.

@@ -37,7 +37,7 @@ from softbench.data import splits
 from softbench.suite import trajectories
 
 HOLD_SECONDS = 2.0  # (s) How long the refinement holds an action, and how long a still goal waits
-# before its correction starts; longer than every benchmark robot's settling time (tendon-5
+# before its correction starts; longer than every registered robot's settling time (tendon-5
 # 0.72 s, pneumatic-433 1.39 s).
 REFINEMENT_STEPS = 5  # Damped Gauss-Newton steps on the action for a new goal.
 WARM_REFINEMENT_STEPS = 1  # Steps for a corrected goal, from the last action found.

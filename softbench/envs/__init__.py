@@ -2,7 +2,7 @@
 
 Importing this module registers, in Gymnasium's ``softbench`` namespace,
 
-  softbench/<robot>-<task>-vN   every benchmark robot with every task of the suite
+  softbench/<robot>-<task>-vN   every registered robot with every task of the suite
   softbench/SoftArm-vN          any robot and task: ``robot=`` and ``task=`` options
 
 where vN is the installed physics version (``softbench.robots.versions``): v1 on MuJoCo 4, v0 on
@@ -30,19 +30,19 @@ ANY_ROBOT_ID = f"{NAMESPACE}/SoftArm-v{VERSION}"
 
 
 def env_id(robot: str, task: str) -> str:
-  """The Gymnasium id of ``task`` on the benchmark robot ``robot``."""
+  """The Gymnasium id of ``task`` on the registered robot ``robot``."""
   return f"{NAMESPACE}/{robot}-{task}-v{VERSION}"
 
 
 def env_ids() -> tuple[str, ...]:
-  """Every registered (benchmark robot, task) id, ``custom`` included (it needs ``trajectory=``),
+  """Every registered (registered robot, task) id, ``custom`` included (it needs ``trajectory=``),
   tasks registered after this module's import too."""
-  return tuple(env_id(robot, task) for robot in robots.BENCHMARK_ROBOTS for task in suite.TASKS)
+  return tuple(env_id(robot, task) for robot in robots.REGISTERED_ROBOTS for task in suite.TASKS)
 
 
 def _register_task(task: str) -> None:
-  """Registers ``task``'s id on every benchmark robot (once: importing again changes nothing)."""
-  for robot in robots.BENCHMARK_ROBOTS:
+  """Registers ``task``'s id on every registered robot (once: importing again changes nothing)."""
+  for robot in robots.REGISTERED_ROBOTS:
     if env_id(robot, task) not in gymnasium.registry:
       gymnasium.register(env_id(robot, task), ENTRY_POINT, kwargs={"robot": robot, "task": task})
 

@@ -5,9 +5,7 @@ from softbench import agents
 from softbench import robots
 from softbench import suite
 
-ROBOTS = ("tendon-3", "tendon-local-3", "pneumatic-433")
-"""The paper's robots (Exp2S tracking on tendon-3, reaching on pneumatic-433) and tendon-3's
-module-local plant, the paper simulator's arm."""
+ROBOTS = robots.LEADERBOARD_ROBOTS
 
 
 def lists() -> dict[str, tuple[str, ...]]:

@@ -16,7 +16,7 @@ DEFAULT_FPS = 30.0  # (frames/s)
 MIN_SIZE = 16  # (pixels) Smallest width or height.
 MAX_SIZE = 4096  # (pixels) Largest width or height (the off-screen buffer grows to the request).
 MAX_FPS = 240.0  # (frames/s)
-MAX_FRAMES_PER_STEP = 100  # Frames within one control period (benchmark robots: 200 or more
+MAX_FRAMES_PER_STEP = 100  # Frames within one control period (registered robots: 200 or more
 # physics steps per period; the replay refuses more frames than steps).
 CAMERAS = ("workspace", "front", "side", "below")
 """Named cameras of every rendered scene, each framing the whole episode: ``workspace`` an

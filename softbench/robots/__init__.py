@@ -1,6 +1,6 @@
 """The robot registry: ``make('tendon-3')``, ``make('tendon-local-3')``, ``make('pneumatic-433')``.
 
-``BENCHMARK_ROBOTS`` are the configurations of the paper, on both tendon plants; any
+``REGISTERED_ROBOTS`` are the configurations of the paper, on both tendon plants; any
 ``tendon-N`` or ``tendon-local-N`` with N from 1 to ``tendon.MAX_MODULES`` builds.
 """
 
@@ -50,7 +50,7 @@ class Family:
 
   @property
   def example(self) -> str:
-    """A small robot that shows the family's layout: its second benchmark robot (two modules on a
+    """A small robot that shows the family's layout: its second registered robot (two modules on a
     numbered family, so that observations hold more than one module), or its only one."""
     return self.benchmark[min(1, len(self.benchmark) - 1)]
 
@@ -73,7 +73,11 @@ FAMILIES = (
 )
 """Every robot family; a new one is an arm class and one entry here. A name belongs to the
 longest family name it starts with (``tendon-local-x`` is a malformed ``tendon-local`` name)."""
-BENCHMARK_ROBOTS = tuple(robot for family in FAMILIES for robot in family.benchmark)
+REGISTERED_ROBOTS = tuple(robot for family in FAMILIES for robot in family.benchmark)
+LEADERBOARD_ROBOTS = ("tendon-3", "tendon-local-3", "pneumatic-433")
+"""The registered robots the leaderboard ranks agents on: the paper's (Exp2S tracking on
+tendon-3, reaching on pneumatic-433) and tendon-3's module-local plant, the paper simulator's
+arm."""
 NAME_PATTERN = f"^({'|'.join(family.pattern for family in FAMILIES)})$"
 """Every robot name any family answers, as a regular expression (for the records' schema)."""
 
@@ -118,7 +122,7 @@ def _checked(family: type, overrides: dict) -> dict:
 
 
 __all__ = [
-  "BENCHMARK_ROBOTS",
+  "REGISTERED_ROBOTS",
   "FAMILIES",
   "MAX_MODULES",
   "NAME_PATTERN",

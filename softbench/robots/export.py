@@ -1,4 +1,4 @@
-"""``softbench models export``: writes ``models/<name>/`` for every benchmark robot.
+"""``softbench models export``: writes ``models/<name>/`` for every registered robot.
 
 Each folder holds the robot (``<name>.xml``), a ``scene.xml`` that includes it and adds a floor
 and light, and a ``README.md`` with how it was built and its measured physics. Simulation speed

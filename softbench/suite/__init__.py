@@ -1,7 +1,7 @@
 """The softbench task suite, in the style of ``dm_control.suite``.
 
 ``load(robot, task, seed)`` returns a ``dm_control.rl.control.Environment``. Every task exists
-for every robot; ``ALL_TASKS`` lists the (robot, task) pairs of the benchmark robots and
+for every robot; ``ALL_TASKS`` lists the (robot, task) pairs of the registered robots and
 ``BENCHMARKING`` those tagged ``benchmarking`` (dm_control's convention; so far every one).
 ``custom`` follows a user's trajectory (``trajectory=ARRAY_OR_PATH``; ``given="2:position"``
 when it gives only part of the target, ``trajectories.Given``) and is in neither list, as it
@@ -131,11 +131,11 @@ TASKS = tuple(_TASKS)
 
 
 def _pairs() -> tuple[tuple[tuple[str, str], ...], tuple[tuple[str, str], ...]]:
-  """Every (robot, task) pair of the benchmark robots and the tasks that need no user input, and
+  """Every (robot, task) pair of the registered robots and the tasks that need no user input, and
   those of them tagged ``benchmarking``."""
   every = tuple(
     (robot, task)
-    for robot in robots.BENCHMARK_ROBOTS
+    for robot in robots.REGISTERED_ROBOTS
     for task in TASKS
     if "user" not in _TASKS[task].tags
   )

@@ -13,7 +13,7 @@ from softbench.suite import base
 
 REACH_SECONDS = 10.0  # (s) Episode duration.
 TARGET_SETTLE_SECONDS = 3.0  # (s) Time the target-defining action is held; longer than every
-# benchmark robot's settling time (tendon-5 0.72 s, pneumatic-433 1.39 s).
+# registered robot's settling time (tendon-5 0.72 s, pneumatic-433 1.39 s).
 DEFAULT_MODULE = 2  # The paper's reaching experiment moves module 2 (module 1 on a 1-module arm).
 
 

@@ -74,7 +74,7 @@ def bend_amplitude(robot: base.SoftArm) -> float:
 
   The grid is held in ascending batches of one actuation per core, up to the batch that reaches
   ``BEND_DEG``: the answer of holding the whole grid (each actuation is simulated on its own),
-  holding 25 to 70 % of its actuations on the benchmark robots (the most on one-module arms)."""
+  holding 25 to 70 % of its actuations on the registered robots (the most on one-module arms)."""
   holds = int(np.ceil(SETTLE_SECONDS / robot.control_timestep))
   batch = os.cpu_count() or 1
   pose_recorder = recorder.PoseRecorder(robot, workers=batch)
