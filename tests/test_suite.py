@@ -190,8 +190,8 @@ def test_reference_is_cached_and_a_corrupt_cache_is_regenerated(monkeypatch, tmp
   def must_not_simulate(*args, **kwargs):
     raise AssertionError("a cached reference was simulated again")
 
-  with monkeypatch.context() as patch:  # Nor taken from the process's recordings.
-    patch.setattr(recorder, "from_rest", must_not_simulate)
+  with monkeypatch.context() as patch:
+    patch.setattr(recorder.PoseRecorder, "record", must_not_simulate)
     cached = references.reference(arm, "circle", length=5)
   np.testing.assert_array_equal(cached.poses, first.poses)
 
@@ -204,6 +204,20 @@ def test_reference_is_cached_and_a_corrupt_cache_is_regenerated(monkeypatch, tmp
   np.testing.assert_array_equal(regenerated.poses, first.poses)
   meta = json.loads(npz.with_suffix(".json").read_text())
   assert meta["config"]["shape"] == "circle"
+
+
+def test_simulating_a_reference_says_so_once(monkeypatch, tmp_path, capsys):
+  # The first suite.load of a (robot, task) waits 7 to 132 s for its reference: never silently.
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
+  arm = robots.make("tendon-1")
+  simulated = references.reference(arm, "spiral", length=6)
+  line = (
+    "simulating tendon-1's spiral reference (6 control steps; once, then cached in the data home)"
+  )
+  assert capsys.readouterr().err.splitlines() == [line]
+  np.testing.assert_array_equal(simulated.poses, recorder.from_rest(arm, simulated.actions))
+  references.reference(arm, "spiral", length=6)
+  assert capsys.readouterr().err == ""
 
 
 @pytest.mark.parametrize(

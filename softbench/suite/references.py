@@ -23,9 +23,12 @@ import functools
 import hashlib
 import json
 import os
+import sys
 
 import numpy as np
+from rich import console
 
+from softbench import progress
 from softbench import storage
 from softbench.data import dataset
 from softbench.data import seeding
@@ -212,6 +215,28 @@ def _load_cached(path, config: dict) -> Reference | None:
   return storage.read_cached(path, read, "cached reference", "generating it again", (meta_path,))
 
 
+def _simulate(robot: base.SoftArm, shape: str, length: int) -> tuple[np.ndarray, np.ndarray]:
+  """The actions of reference ``shape`` and the poses they give, simulated from rest, saying so
+  on stderr: a line, then a bar of the control steps (7 to 36 s on tendon-1..3 and up to 132 s on
+  tendon-5's babbling, once per data home; the planar shapes' calibration, up to 5 s, first)."""
+  print(
+    f"simulating {robot.name}'s {shape} reference ({length} control steps; once, then cached in "
+    f"the data home)",
+    file=sys.stderr,
+    flush=True,
+  )
+  display = progress.counting(
+    extra=progress.time_left(), transient=True, console=console.Console(stderr=True)
+  )
+  with display:
+    bar = display.add_task(f"{robot.name} {shape} reference", total=length)
+    actions = pattern_actions(robot, shape, length)
+    poses, _ = recorder.PoseRecorder(robot).record(
+      actions[None], on_step=lambda episodes: display.advance(bar)
+    )
+  return actions, poses[0]
+
+
 def reference(robot: base.SoftArm, shape: str, length: int = REFERENCE_LENGTH) -> Reference:
   """The reference ``shape`` of ``robot``, from the cache or simulated (and then cached)."""
   if not (isinstance(length, int) and length >= 1):
@@ -223,8 +248,7 @@ def reference(robot: base.SoftArm, shape: str, length: int = REFERENCE_LENGTH) -
   cached = _load_cached(path, config)
   if cached is not None:
     return cached
-  actions = pattern_actions(robot, shape, length)
-  poses = recorder.from_rest(robot, actions).copy()
+  actions, poses = _simulate(robot, shape, length)
   arrays = {"actions": actions, "poses": poses}
   storage.write_cache_file(path, storage.npz_bytes(arrays), "cached reference")
   storage.write_cache_file(
