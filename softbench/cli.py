@@ -13,6 +13,7 @@ import difflib
 import os
 import pathlib
 import sys
+import warnings
 
 from dm_control.rl import control
 
@@ -947,6 +948,14 @@ def _imported_classes(names: tuple[str, ...]) -> tuple[type[BaseException], ...]
   return tuple(found)
 
 
+def _warn_of_left_out_agents() -> None:
+  """A one-line warning per agent of an installed package that could not be registered, where
+  this command loaded the registry (``agents.LEFT_OUT``)."""
+  registry = sys.modules.get("softbench.agents")
+  for message in getattr(registry, "LEFT_OUT", {}).values():
+    warnings.warn(message, RuntimeWarning, stacklevel=1)
+
+
 def main(argv: list[str] | None = None) -> int:
   argv = sys.argv[1:] if argv is None else argv
   try:
@@ -955,6 +964,7 @@ def main(argv: list[str] | None = None) -> int:
   except SystemExit as done:  # --help (0), or a malformed command line (one line, 2).
     return done.code
   terminal.one_line_warnings()
+  _warn_of_left_out_agents()
   try:
     with terminal.sigterm_as_interrupt():
       if args.command in _CACHING_COMMANDS:  # Before any work: a home that takes no file fails

@@ -16,10 +16,14 @@ from gymnasium.utils import env_checker
 import numpy as np
 import pytest
 
+from softbench import agents
+from softbench import evaluation
+from softbench import metrics
 from softbench import robots
 from softbench import suite
 import softbench.envs
 from softbench.envs import environment
+from softbench.envs import scoring
 from softbench.robots import faults
 from softbench.robots import versions
 from softbench.suite import references
@@ -83,6 +87,41 @@ def test_a_seed_starts_the_episode_the_suite_starts_with_that_seed(robot, task):
   np.testing.assert_array_equal(again, make(robot, task).reset(seed=7)[0])
   other, _ = env.reset(seed=8)
   assert not np.array_equal(other[layout["previous_action"]], again[layout["previous_action"]])
+
+
+@pytest.mark.parametrize("robot,task", FAMILY_PAIRS)
+def test_info_and_score_policy_score_as_the_leaderboard_does(robot, task):
+  # A run's episode (evaluation.run_episode, scored by metrics.score), replayed through the
+  # Gymnasium environment: info's errors and score_policy's figures are the run's.
+  agent = agents.make("random", robot, seed=0)
+  run = evaluation.run_episode(suite.load(robot, task, seed=0, **short(task)), agent, task)
+  expected = metrics.score(run.achieved, run.targets, robots.make(robot).length)
+  replayed = list(run.actions)  # score_policy's seed 0 is the run's seed 0.
+  infos = []
+  env = make(robot, task)
+  env.reset(seed=0)
+  for action in run.actions:
+    infos.append(env.step(action)[-1])
+  assert infos[-1]["scored_modules"] == tuple(run.scored_modules)
+  for step, info in enumerate(infos):
+    np.testing.assert_array_equal(
+      info["position_error_mm"], metrics.position_error_mm(run.achieved[step], run.targets[step])
+    )
+  assert ("orientation_error_deg" in infos[0]) == bool(expected.orientation_deg)
+  score = scoring.score_policy(lambda observation: replayed.pop(0), robot, task, 1, **short(task))
+  pairs = [
+    ("position_mm", "position_error_mm"),
+    ("normalised_tip_percent", "normalised_tip_error_percent"),
+  ]
+  pairs += [("orientation_deg", "orientation_error_deg")] if expected.orientation_deg else []
+  for metric, name in pairs:
+    assert score.of(name).mean == pytest.approx(expected.average(metric).mean, rel=1e-12)
+  assert str(score).startswith(f"{task} on {robot}: position error ")
+
+
+def test_score_policy_refuses_a_bad_seed_count():
+  with pytest.raises(ValueError, match="seeds must be an integer from 1 to 1000"):
+    scoring.score_policy(lambda observation: None, "tendon-1", "circle", seeds=0)
 
 
 @pytest.mark.parametrize("robot,task", FAMILY_PAIRS)

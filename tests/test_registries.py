@@ -2,6 +2,11 @@
 task (``example_task.py``) each join by one registry line, and then build, train, run and score
 through the same code as the built-in ones. Registration is undone after each test."""
 
+import json
+import os
+import subprocess
+import sys
+
 import example_task
 import gymnasium
 import numpy as np
@@ -105,3 +110,68 @@ def test_a_bad_registration_is_refused_with_one_line(register, message, restored
   with pytest.raises(ValueError, match=message) as error:
     register()
   assert "\n" not in str(error.value)
+
+
+_PLUGIN_MODULE = """
+import numpy as np
+
+from softbench import agents
+from softbench.agents import base
+
+
+class HoldStill(base.Agent):
+  def act(self, observation):
+    return np.asarray(observation["previous_action"])
+
+
+def build(robot, seed, profile, show_progress=False):
+  return HoldStill(robot, seed)
+
+
+HOLD_STILL = agents.AgentEntry("hold_still_plugin", False, "keeps its last action")
+NOT_AN_ENTRY = 3
+"""
+
+
+@pytest.fixture
+def installed_plugin(tmp_path) -> dict:
+  """The environment of a child process in which a package of agents is installed: its module and
+  its dist-info, with one good entry point and one that names no ``AgentEntry``."""
+  (tmp_path / "hold_still_plugin.py").write_text(_PLUGIN_MODULE)
+  info = tmp_path / "hold_still_plugin-0.1.dist-info"
+  info.mkdir()
+  (info / "METADATA").write_text("Metadata-Version: 2.1\nName: hold-still-plugin\nVersion: 0.1\n")
+  (info / "entry_points.txt").write_text(
+    f"[{agents.ENTRY_POINT_GROUP}]\n"
+    "hold-still = hold_still_plugin:HOLD_STILL\n"
+    "broken = hold_still_plugin:NOT_AN_ENTRY\n"
+  )
+  return {**os.environ, "PYTHONPATH": str(tmp_path), "SOFTBENCH_HOME": str(tmp_path / "home")}
+
+
+def test_an_installed_packages_agent_runs_from_the_command_line(installed_plugin, tmp_path):
+  # In seed workers too (--workers 2): they register the installed agents as the parent does.
+  softbench = [sys.executable, "-c", "import sys; from softbench import cli; sys.exit(cli.main())"]
+  run = ["run", "--task", "circle", "--agent", "hold-still", "--robot", ROBOT, "--profile", "tiny"]
+  run += ["--seeds", "2", "--workers", "2", "--results", str(tmp_path / "results")]
+  result = subprocess.run(
+    softbench + run, env=installed_plugin, capture_output=True, text=True, timeout=600
+  )
+  assert result.returncode == 0, result.stderr
+  (record,) = (tmp_path / "results").glob("hold-still-*.json")
+  assert json.loads(record.read_text())["agent"] == "hold-still"
+  warning = (
+    "softbench: warning: agent 'broken' of entry point "
+    "'hold_still_plugin:NOT_AN_ENTRY' left out: it names a int, not a softbench.agents.AgentEntry"
+  )
+  assert result.stderr.splitlines().count(warning) == 1, result.stderr
+  listed = subprocess.run(
+    softbench + ["agents"], env=installed_plugin, capture_output=True, text=True, timeout=120
+  )
+  assert "hold-still" in listed.stdout and "broken" not in listed.stdout
+  refused = subprocess.run(
+    softbench + [*run[:4], "broken", *run[5:]], env=installed_plugin, capture_output=True, text=True
+  )
+  assert refused.returncode == 2 and refused.stderr.splitlines()[-1] == (
+    "softbench: error: " + warning.removeprefix("softbench: warning: ")
+  )

@@ -3,12 +3,20 @@
 An agent trained on babbling in closed loop is a ``Learner`` (its inverse model and search space)
 in one line of ``_AGENTS``: SMPL's columns, or a centralised model such as ``smpl.baselines``'s.
 Any other agent is one small file with a ``build(robot, seed, profile, show_progress) -> Agent``
-function and one line here. ``register`` adds an agent from outside the package. Tests cover
-every entry with no new test code.
+function and one line here. ``register`` adds an agent from outside the package for one
+process; an installed package declares its agents for every process (the command line's, its
+seed and sweep workers) as entry points of the group ``ENTRY_POINT_GROUP``, each named after its
+agent and pointing at an ``AgentEntry``::
+
+  [project.entry-points."softbench.agents"]
+  hold-still = "my_package.agents:HOLD_STILL"
+
+Tests cover every entry with no new test code.
 """
 
 import collections
 import importlib
+from importlib import metadata
 from typing import Callable
 
 from softbench import profiles
@@ -104,7 +112,40 @@ def register(name: str, entry: AgentEntry) -> None:
   AGENTS = tuple(_AGENTS)
 
 
+ENTRY_POINT_GROUP = "softbench.agents"
+
+
+def register_installed() -> list[str]:
+  """Registers the agents that installed packages declare (``ENTRY_POINT_GROUP``) and returns
+  their names; one that cannot be loaded or registered is left out, with why, in ``LEFT_OUT``
+  (which the command line prints as one-line warnings, and ``describe`` names)."""
+  added = []
+  for point in metadata.entry_points(group=ENTRY_POINT_GROUP):
+    if point.name in _INSTALLED:
+      continue  # Registered by an earlier call.
+    try:
+      entry = point.load()
+      if not isinstance(entry, AgentEntry):
+        raise TypeError(f"it names a {type(entry).__name__}, not a softbench.agents.AgentEntry")
+      register(point.name, entry)
+    except Exception as error:  # A broken package must not break softbench: it is named.
+      reason = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
+      LEFT_OUT[point.name] = (
+        f"agent {point.name!r} of entry point {point.value!r} left out: {reason}"
+      )
+      continue
+    _INSTALLED[point.name] = entry
+    added.append(point.name)
+  return added
+
+
+_INSTALLED: dict[str, AgentEntry] = {}  # The agents register_installed added, by name.
+LEFT_OUT: dict[str, str] = {}  # Installed agents that could not be registered: name -> why.
+
+
 def describe(name: str) -> AgentEntry:
+  if name in LEFT_OUT and name not in _AGENTS:
+    raise ValueError(LEFT_OUT[name])
   if name not in _AGENTS:
     raise ValueError(f"unknown agent {name!r}; choose one of {', '.join(AGENTS)}")
   return _AGENTS[name]
@@ -160,6 +201,8 @@ def babbling_learners() -> tuple[str, ...]:
   return tuple(name for name in AGENTS if learner(name) is not None)
 
 
+register_installed()
+
 __all__ = [
   "AGENTS",
   "Agent",
@@ -171,5 +214,6 @@ __all__ = [
   "learner",
   "make",
   "register",
+  "register_installed",
   "training_summary",
 ]

@@ -13,6 +13,16 @@ flat form concatenates them in that order, each row-major; ``observation_layout`
 the slice of each. Actions are ``Box(-1, 1)``. The episode ends with ``truncated`` when the
 task's reference (or reach's time) runs out; no state of the arm ends it (``terminated`` is
 always False). ``reset(seed=s)`` starts the episode that ``suite.load(..., seed=s)`` starts.
+
+``step``'s ``info`` scores the step as the leaderboard does (``softbench.metrics``): each scored
+module's pose after the step against the target it was shown before it, per scored module
+(arrays in the order of ``info["scored_modules"]``, 1-based):
+
+  position_error_mm             (scored,)  Euclidean distance of the tip to its target (mm)
+  orientation_error_deg         (scored,)  angle to the target's orientation (absent for reach)
+  normalised_tip_error_percent  (scored,)  position error / the arm's length (%)
+
+``scoring.score_policy`` averages them over an episode and seeds into the leaderboard's figures.
 """
 
 from typing import Any
@@ -21,6 +31,7 @@ import gymnasium
 from gymnasium import spaces
 import numpy as np
 
+from softbench import metrics
 from softbench import robots
 from softbench import suite
 from softbench.data import seeding
@@ -153,6 +164,7 @@ class SoftArmEnv(gymnasium.Env):
     super().reset(seed=seed)
     time_step = self._environment.reset()
     self._ended = False
+    self._target = time_step.observation["target"]
     if self._view is not None:
       self._view.start(self._environment.physics, self._environment.task)
     return self._observation(time_step.observation), {}
@@ -162,7 +174,25 @@ class SoftArmEnv(gymnasium.Env):
       raise RuntimeError("the episode has ended (or not started); call reset() first")
     time_step = self._environment.step(np.asarray(action, dtype=np.float64))
     self._ended = time_step.last()
-    return self._observation(time_step.observation), float(time_step.reward), False, self._ended, {}
+    info = self._errors(time_step.observation["poses"], self._target)
+    self._target = time_step.observation["target"]
+    observation = self._observation(time_step.observation)
+    return observation, float(time_step.reward), False, self._ended, info
+
+  def _errors(self, poses: np.ndarray, target: np.ndarray) -> dict[str, Any]:
+    """``step``'s info: the scored modules' errors of ``poses`` against ``target``."""
+    scored = tuple(self._environment.task.scored_modules())
+    achieved = np.asarray(poses)[np.array(scored) - 1, : target.shape[-1]]
+    info = {
+      "scored_modules": scored,
+      "position_error_mm": metrics.position_error_mm(achieved, target),
+      "normalised_tip_error_percent": metrics.normalised_tip_error_percent(
+        achieved, target, self.robot.length
+      ),
+    }
+    if target.shape[-1] == 6:
+      info["orientation_error_deg"] = metrics.orientation_error_deg(achieved, target)
+    return info
 
   def render(self) -> np.ndarray | None:
     """(height, width, 3) uint8: the arm and the current targets, with render_mode

@@ -1,0 +1,87 @@
+"""Scores any policy of a Gymnasium environment the leaderboard's way, e.g. a Stable-Baselines3
+model::
+
+  from softbench.envs import scoring
+  score = scoring.score_policy(lambda obs: model.predict(obs, deterministic=True)[0],
+                               "tendon-3", "spiral")
+  print(score)  # position error 7.08 ± 1.12 mm (5 seeds), ...
+
+Seed s is one episode from ``reset(seed=s)``, the episode ``softbench run`` scores its agent's
+seed s on; each figure is the episode's mean over steps and scored modules of the errors that
+``step`` reports in ``info`` (``environment.SoftArmEnv``), then mean ± standard deviation over
+seeds (ddof 0), as the leaderboard ranks records. The task runs its full reference, as on the
+``default`` and ``paper`` profiles.
+"""
+
+from collections.abc import Callable
+import dataclasses
+
+import numpy as np
+
+from softbench import metrics
+from softbench import robots
+from softbench.envs import environment
+
+DEFAULT_SEEDS = 5  # As the default and paper profiles score.
+METRICS = ("position_error_mm", "orientation_error_deg", "normalised_tip_error_percent")
+_UNITS = {"position_error_mm": "mm", "orientation_error_deg": "deg"}
+
+
+@dataclasses.dataclass(frozen=True)
+class PolicyScore:
+  """A policy's errors on one task: per seed, each metric's episode mean over steps and scored
+  modules; ``of(metric)`` their mean and standard deviation over seeds."""
+
+  robot: str
+  task: str
+  per_seed: tuple[dict[str, float], ...]
+
+  def of(self, metric: str) -> metrics.Statistic:
+    return metrics.Statistic.of([seed[metric] for seed in self.per_seed])
+
+  def __str__(self) -> str:
+    shown = [metric for metric in METRICS if metric in self.per_seed[0]]
+    return (
+      f"{self.task} on {self.robot}: "
+      + ", ".join(
+        f"{metric.removesuffix('_mm').removesuffix('_deg').replace('_', ' ')} "
+        f"{self.of(metric).mean:.4g} ± {self.of(metric).std:.2g} {_UNITS.get(metric, '%')}"
+        for metric in shown
+      )
+      + f" ({len(self.per_seed)} seeds)"
+    )
+
+
+def score_policy(
+  policy: Callable[[np.ndarray | dict], np.ndarray],
+  robot: str | robots.SoftArm,
+  task: str,
+  seeds: int = DEFAULT_SEEDS,
+  **options,
+) -> PolicyScore:
+  """``policy(observation) -> action`` scored on ``task`` of ``robot`` over seeds 0..seeds-1;
+  ``options``: ``SoftArmEnv``'s (``observation="dict"``, the task's options).
+
+  Raises:
+    ValueError: a bad robot, task, option or seed count (one line).
+  """
+  if not (isinstance(seeds, int) and 1 <= seeds <= 1000):
+    raise ValueError(f"seeds must be an integer from 1 to 1000, got {seeds!r}")
+  env = environment.SoftArmEnv(robot, task, **options)
+  per_seed = []
+  for seed in range(seeds):
+    observation, _ = env.reset(seed=seed)
+    steps, done = [], False
+    while not done:
+      observation, _, terminated, truncated, info = env.step(policy(observation))
+      steps.append(info)
+      done = terminated or truncated
+    per_seed.append(
+      {
+        metric: float(np.mean([step[metric] for step in steps], axis=0).mean())
+        for metric in METRICS
+        if metric in steps[0]
+      }
+    )
+  env.close()
+  return PolicyScore(env.robot.name, task, tuple(per_seed))
