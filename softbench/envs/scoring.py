@@ -23,8 +23,11 @@ from softbench import robots
 from softbench.envs import environment
 
 DEFAULT_SEEDS = 5  # As the default and paper profiles score.
-METRICS = ("position_error_mm", "orientation_error_deg", "normalised_tip_error_percent")
-_UNITS = {"position_error_mm": "mm", "orientation_error_deg": "deg"}
+METRICS = {  # info's errors: how a score names them, and their units.
+  "position_error_mm": ("position error", "mm"),
+  "orientation_error_deg": ("orientation error", "deg"),
+  "normalised_tip_error_percent": ("normalised tip error", "%"),
+}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -41,15 +44,12 @@ class PolicyScore:
 
   def __str__(self) -> str:
     shown = [metric for metric in METRICS if metric in self.per_seed[0]]
-    return (
-      f"{self.task} on {self.robot}: "
-      + ", ".join(
-        f"{metric.removesuffix('_mm').removesuffix('_deg').replace('_', ' ')} "
-        f"{self.of(metric).mean:.4g} ± {self.of(metric).std:.2g} {_UNITS.get(metric, '%')}"
-        for metric in shown
-      )
-      + f" ({len(self.per_seed)} seeds)"
+    figures = (
+      f"{METRICS[metric][0]} {self.of(metric).mean:.4g} ± {self.of(metric).std:.2g} "
+      f"{METRICS[metric][1]}"
+      for metric in shown
     )
+    return f"{self.task} on {self.robot}: {', '.join(figures)} ({len(self.per_seed)} seeds)"
 
 
 def score_policy(
