@@ -13,6 +13,7 @@ gives the mean and standard deviation of a figure across seeds.
 """
 
 import dataclasses
+import math
 
 import numpy as np
 
@@ -58,6 +59,25 @@ def normalised_tip_error_percent(
   if not robot_length > 0:
     raise ValueError(f"robot_length must be positive, got {robot_length}")
   return position_error_mm(achieved, target) / (robot_length * MM_PER_M) * PERCENT
+
+
+def decimals_of(value: float) -> int:
+  """How many decimals a figure is printed with: 2 from 1 up; below 1, enough for 3 significant
+  digits (a reach error of 0.0094 mm is 0.00940, not 0.01)."""
+  if value == 0 or abs(value) >= 1:
+    return 2
+  return max(2, 2 - math.floor(math.log10(abs(value))))
+
+
+def number(value: float, decimals: int | None = None) -> str:
+  """A figure as softbench prints it, with ``decimals`` (default: ``decimals_of(value)``)."""
+  return f"{value:.{decimals_of(value) if decimals is None else decimals}f}"
+
+
+def mean_and_std(mean: float, std: float) -> str:
+  """``mean ± std``, both with the decimals of the mean."""
+  decimals = decimals_of(mean)
+  return f"{number(mean, decimals)} ± {number(std, decimals)}"
 
 
 @dataclasses.dataclass(frozen=True)

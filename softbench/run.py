@@ -527,7 +527,9 @@ def table(record: dict) -> str:
     for name, _ in measured:
       per_module, average = columns[name]
       statistic = average if index == len(rows) - 1 else per_module[index]
-      cells.append(f"{statistic.mean:>13.2f} ± {statistic.std:<6.2f}")
+      decimals = metrics.decimals_of(statistic.mean)  # Micrometres too: 0.00940, not 0.01.
+      mean, std = (metrics.number(value, decimals) for value in (statistic.mean, statistic.std))
+      cells.append(f"{mean:>13} ± {std:<6}")
     lines.append(f"{row:<10}" + "".join(cells))
   lines.append(f"wall time {record['wall_time_s']:.1f} s")
   return "\n".join(lines)

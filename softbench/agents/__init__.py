@@ -31,11 +31,12 @@ from softbench.agents.learners import LogUniform
 from softbench.data import seeding
 
 AgentEntry = collections.namedtuple(
-  "AgentEntry", ["module", "learned", "description", "learner"], defaults=[None]
+  "AgentEntry", ["module", "learned", "description", "learner", "oracle"], defaults=[None, False]
 )
 """An agent: the module whose ``build`` makes it (None for a babbling learner, which
-``agents.learned`` trains), whether it learns, a one-line description and its ``Learner`` (None:
-not trained on babbling)."""
+``agents.learned`` trains), whether it learns, a one-line description, its ``Learner`` (None:
+not trained on babbling), and whether it is an oracle: one that uses the simulator itself, which
+the leaderboard shows as a bound, apart from the ranking."""
 
 
 def _babbling_learner(description: str, learner: Learner) -> AgentEntry:
@@ -90,6 +91,7 @@ _AGENTS = {
     "softbench.agents.reference",
     False,
     "model-based: uses the simulator itself (what the physics allows)",
+    oracle=True,
   ),
 }
 AGENTS = tuple(_AGENTS)
@@ -177,6 +179,17 @@ def make(
   return build(arm, seed, profile, show_progress)
 
 
+def is_oracle(name: str) -> bool:
+  """Whether agent ``name`` is a registered oracle (``AgentEntry.oracle``); an agent this
+  installation does not know (a record of another package's) is not."""
+  return name in _AGENTS and _AGENTS[name].oracle
+
+
+def is_learned(name: str) -> bool:
+  """Whether agent ``name`` learns; an agent this installation does not know is taken to."""
+  return name not in _AGENTS or _AGENTS[name].learned
+
+
 def learner(name: str) -> Learner | None:
   """The ``Learner`` of an agent trained on babbling (an inverse model in closed loop,
   ``smpl.training``), None for the others (sac learns by interaction)."""
@@ -211,6 +224,8 @@ __all__ = [
   "Learner",
   "babbling_learners",
   "describe",
+  "is_learned",
+  "is_oracle",
   "learner",
   "make",
   "register",

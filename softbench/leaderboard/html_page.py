@@ -17,6 +17,7 @@ import pathlib
 import jinja2
 import numpy as np
 
+from softbench import agents
 from softbench import profiles
 from softbench.leaderboard import aggregate
 from softbench.leaderboard import csv_table
@@ -25,6 +26,7 @@ from softbench.leaderboard import links
 from softbench.leaderboard import log_chart
 from softbench.leaderboard import overview
 from softbench.leaderboard import ranking
+from softbench.leaderboard import winners
 from softbench.records import fields as record_fields
 
 _HEAT_LOW = (247, 251, 255)  # (RGB) Heat-map colour of 0 %.
@@ -53,6 +55,7 @@ class Cell:
   href: str | None = None
   title: str | None = None
   figure: bool = False  # A mean ± std (left-aligned, tabular digits), else a plain number.
+  best: bool = False  # The best learned agent's figure of its column (``winners``).
 
 
 @dataclasses.dataclass(frozen=True)
@@ -60,6 +63,7 @@ class SortableTable:
   columns: tuple[tuple[str, bool], ...]  # (name, numeric) per column.
   rows: tuple[tuple[Cell, ...], ...]
   caption: str = ""
+  row_classes: tuple[str, ...] = ()  # Per row: "oracle" (shown apart, after the others) or "".
 
 
 @dataclasses.dataclass(frozen=True)
@@ -75,8 +79,11 @@ class Board:
   image: str | None = None  # A figure file beside the page.
 
 
-def _figure(estimate: ranking.Estimate | None, paper: float | None = None, mark: str = "") -> Cell:
-  """A mean ± std cell (followed by ``mark``), with its interval and the paper's value."""
+def _figure(
+  estimate: ranking.Estimate | None, paper: float | None = None, mark: str = "", best: bool = False
+) -> Cell:
+  """A mean ± std cell (followed by ``mark``), with its interval and the paper's value; ``best``
+  marks the best learned agent's."""
   if estimate is None:
     return Cell("-")
   return Cell(
@@ -84,8 +91,14 @@ def _figure(estimate: ranking.Estimate | None, paper: float | None = None, mark:
     estimate.mean,
     None if estimate.interval is None else ranking.interval_text(estimate),
     None if paper is None else f"{paper:.2f}",
+    title=BEST_TITLE if best else None,
     figure=True,
+    best=best,
   )
+
+
+BEST_TITLE = "the best learned agent on this task"
+ORACLE_NOTE = "oracle: uses the simulator itself (a bound on what the physics allows), not ranked"
 
 
 def _metric_caption(metric: str) -> str:
@@ -101,12 +114,13 @@ def _task_boards(group: ranking.Group, out: pathlib.Path, prefix: str = "") -> t
   by_setting: dict[tuple[str, str], list[ranking.Entry]] = {}
   for entry in group.entries:  # Already ranked.
     by_setting.setdefault(entry.setting[1:], []).append(entry)
+  videos = any(links.video(entry, out) for entry in group.entries)
   columns = (
     ("#", True),
     ("agent", False),
     ("seeds", True),
     *((ranking.METRIC_LABELS[metric], True) for metric in group.metrics),
-    ("video", False),
+    *((("video", False),) if videos else ()),
     ("record", False),
   )
   boards = []
@@ -114,18 +128,20 @@ def _task_boards(group: ranking.Group, out: pathlib.Path, prefix: str = "") -> t
     by_setting.items(), key=lambda item: ranking.setting_order(group.robot, *item[0])
   ):
     rows = []
-    for place, entry in enumerate(entries, start=1):
+    places = ranking.places(tuple(entries))
+    for place, entry in zip(places, entries):
       video = links.video(entry, out)
       rows.append(
         (
-          Cell(str(place), place),
+          Cell(place, int(place) if place.isdigit() else len(entries) + 1),
           Cell(entry.shown_setting[0]),
           Cell(str(entry.record["seeds"]), entry.record["seeds"]),
           *(_figure(entry.estimates.get(metric)) for metric in group.metrics),
-          Cell("video", href=video) if video else Cell("-"),
+          *(((Cell("video", href=video) if video else Cell("-")),) if videos else ()),
           Cell("json", href=links.record(entry, out), title=entry.path.name),
         )
       )
+    oracle = tuple("oracle" if place == ranking.ORACLE_PLACE else "" for place in places)
     charts = tuple(
       log_chart.chart(
         [
@@ -143,7 +159,7 @@ def _task_boards(group: ranking.Group, out: pathlib.Path, prefix: str = "") -> t
         f"{profile} profile · {eval_mode}",
         profile,
         eval_mode,
-        SortableTable(columns, tuple(rows)),
+        SortableTable(columns, tuple(rows), ORACLE_NOTE if any(oracle) else "", oracle),
         charts,
       )
     )
@@ -151,16 +167,22 @@ def _task_boards(group: ranking.Group, out: pathlib.Path, prefix: str = "") -> t
 
 
 def _overview_board(view: overview.Overview) -> Board:
-  agents_shown = [row[0] for row in view.table.rows]
+  """The overview's table: the best learned agent of each column marked, the oracles last."""
+  shown = [row[0] for row in view.table.rows]
+  agents_shown = [a for a in shown if not agents.is_oracle(a)] + [
+    a for a in shown if agents.is_oracle(a)
+  ]
   tasks = view.table.header[1:]
+  best = winners.best_cells(view)
   rows = tuple(
     (
-      Cell(agent),
+      Cell(f"{agent} (oracle)" if agents.is_oracle(agent) else agent),
       *(
         _figure(
           view.estimates.get((agent, task)),
           overview.paper_mean(view.robot, task, agent),
           view.marks.get((agent, task), ""),
+          (agent, task) in best,
         )
         for task in tasks
       ),
@@ -168,10 +190,53 @@ def _overview_board(view: overview.Overview) -> Board:
     for agent in agents_shown
   )
   columns = (("agent", False), *((f"{task} (mm)", True) for task in tasks))
-  caption = view.table.caption + f"; [{ranking.CONFIDENCE:.0%} bootstrap CI]"
+  caption = view.table.caption + f"; [{ranking.CONFIDENCE:.0%} bootstrap CI]; ★ {BEST_TITLE}"
+  oracle = tuple("oracle" if agents.is_oracle(agent) else "" for agent in agents_shown)
   return Board(
-    view.anchor, view.title, view.profile, view.eval_mode, SortableTable(columns, rows, caption)
+    view.anchor,
+    view.title,
+    view.profile,
+    view.eval_mode,
+    SortableTable(columns, rows, caption, oracle),
   )
+
+
+def _winner_boards(views: tuple[overview.Overview, ...], linked: bool = True) -> list[dict]:
+  """The first screen: per profile and eval mode, each robot's best learned agent per task and
+  the oracle's figure apart (``winners``); ``linked``: each robot links to its overview (which
+  only the current physics' section has)."""
+  found = winners.rows(views)
+  boards: dict[tuple[str, str], dict] = {}
+  for row in found:
+    view = row.view
+    board = boards.setdefault(
+      (view.profile, view.eval_mode),
+      {
+        "profile": view.profile,
+        "eval_mode": view.eval_mode,
+        "title": f"{view.profile} profile · eval {view.eval_mode}",
+        "tasks": winners.tasks(views),
+        "rows": [],
+      },
+    )
+    board["rows"].append(
+      {
+        "robot": view.robot,
+        "anchor": view.anchor if linked else None,
+        "cells": [
+          {
+            "task": best.task,
+            "agent": best.agent,
+            "figure": best.figure,
+            "oracle": "; ".join(
+              f"{agent} {ranking.mean_and_std(estimate)}" for agent, estimate in best.oracles
+            ),
+          }
+          for best in row.best
+        ],
+      }
+    )
+  return list(boards.values())
 
 
 def _aggregate_board(view: aggregate.View) -> Board:
@@ -194,7 +259,7 @@ def _aggregate_board(view: aggregate.View) -> Board:
     )
   columns = (("agent", False), ("runs", True), ("IQM", True), ("median", True))
   estimates = [
-    (found.agent, found.agent, ranking.Estimate(found.iqm, 0.0, found.interval))
+    (found.agent, found.agent, ranking.Estimate(found.iqm, None, found.interval))
     for found in view.aggregates
   ]
   chart = log_chart.chart(
@@ -251,18 +316,22 @@ def _by_robot(boards: Iterable[tuple[str, Board]]) -> dict[str, list[Board]]:
 
 
 def _filters(board: ranking.Leaderboard) -> dict[str, list[str]]:
-  """The profiles and eval modes the records hold, in their registry order."""
-  profiles_found = {entry.setting[1] for group in board.groups for entry in group.entries}
-  profiles_found |= {entry.setting[1] for group in board.exp1s for entry in group.entries}
-  modes = {entry.setting[2] for group in board.groups for entry in group.entries}
-  return {
-    "profiles": sorted(
-      profiles_found, key=lambda name: ranking.known_first(name, profiles.PROFILES)
-    ),
-    "eval_modes": sorted(
-      modes, key=lambda name: ranking.known_first(name, record_fields.ERROR_SOURCES)
-    ),
-  }
+  """The profiles and eval modes the records hold, in their registry order: the current
+  physics' first (the first is chosen when the page opens), then the earlier versions' others."""
+  boards = (board, *board.earlier)
+  chosen: dict[str, list[str]] = {"profiles": [], "eval_modes": []}
+  for shown in boards:
+    entries = [entry for group in shown.groups for entry in group.entries]
+    found_profiles = {entry.setting[1] for entry in entries}
+    found_profiles |= {entry.setting[1] for group in shown.exp1s for entry in group.entries}
+    found_modes = {entry.setting[2] for entry in entries}
+    for key, found, order in (
+      ("profiles", found_profiles, profiles.PROFILES),
+      ("eval_modes", found_modes, record_fields.ERROR_SOURCES),
+    ):
+      new = sorted(set(found) - set(chosen[key]), key=lambda name: ranking.known_first(name, order))
+      chosen[key] += new
+  return chosen
 
 
 @dataclasses.dataclass(frozen=True)
@@ -298,6 +367,11 @@ def render(board: ranking.Leaderboard, results: pathlib.Path, out: pathlib.Path)
     csv_file=csv_table.FILE_NAME,
     filters=_filters(board),
     overviews=_by_robot((view.robot, _overview_board(view)) for view in views),
+    winners=_winner_boards(views),
+    earlier_winners=[
+      (older.physics_description, _winner_boards(overview.overviews(older), linked=False))
+      for older in board.earlier
+    ],
     about_paper=overview.about_paper(),
     across=_by_robot((view.robot, _aggregate_board(view)) for view in aggregate.views(board)),
     task_groups=[(group, _task_boards(group, out)) for group in board.groups],

@@ -3,12 +3,13 @@
 Within a group (robot, task, and for ``custom`` the trajectory; records with extra sections, such
 as a fault, form groups of their own), each (agent, profile, eval mode) is represented by its
 newest record (by date, then file name); older ones are kept as superseded. Rows are ordered by
-the mean over seeds of the episode's module-averaged position error. Every metric gets the mean
-and standard deviation (ddof 0, as ``softbench run`` prints) over seeds of the per-seed means and
-a 95 % percentile bootstrap confidence interval of the mean (``scipy.stats.bootstrap``, the method
-rliable uses by default), with a fixed random generator so that the same records give the same
-numbers; with fewer than 2 seeds there is no interval. Exp1S records are grouped apart
-(``exp1s_board``), in the paper's layout rather than a ranking.
+the mean over seeds of the episode's module-averaged position error; an oracle (an agent that
+uses the simulator itself, ``agents.is_oracle``) comes after the others and takes no place. Every
+metric gets the mean and standard deviation (ddof 0, as ``softbench run`` prints) over seeds of
+the per-seed means and a 95 % percentile bootstrap confidence interval of the mean
+(``scipy.stats.bootstrap``, the method rliable uses by default), with a fixed random generator so
+that the same records give the same numbers; with fewer than 2 seeds there is no interval.
+Exp1S records are grouped apart (``exp1s_board``), in the paper's layout rather than a ranking.
 
 Records of different physics versions (``softbench.robots.versions``) are never ranked together:
 the board holds the records of the newest version any record has, and each earlier version's
@@ -19,12 +20,13 @@ from collections.abc import Iterator
 import dataclasses
 import datetime
 import functools
-import math
 import pathlib
 import re
 
 import numpy as np
 
+from softbench import agents
+from softbench import metrics
 from softbench import profiles
 from softbench import records
 from softbench import suite
@@ -51,7 +53,7 @@ class Estimate:
   (``None`` with fewer than ``MIN_SEEDS_FOR_INTERVAL`` seeds)."""
 
   mean: float
-  std: float
+  std: float | None  # None for a figure with no spread over seeds (an aggregate's IQM).
   interval: tuple[float, float] | None
 
   @classmethod
@@ -261,7 +263,14 @@ def _rank_one(loaded: list[tuple[pathlib.Path, dict]], physics: str) -> Leaderbo
   groups = []
   for key in sorted(by_group, key=lambda k: (robot_order(k[0]), suite.TASKS.index(k[1]), k[2])):
     shown, superseded = selection.newest_per_setting(by_group[key])
-    ranked = sorted(shown, key=lambda entry: (entry.estimates[RANKED_BY].mean, entry.setting))
+    ranked = sorted(
+      shown,
+      key=lambda entry: (
+        agents.is_oracle(entry.setting[0]),
+        entry.estimates[RANKED_BY].mean,
+        entry.setting,
+      ),
+    )
     groups.append(Group(*key, tuple(ranked), tuple(superseded)))
   latest = max((record for _, record in loaded), key=_moment, default=None)
   return Leaderboard(
@@ -273,22 +282,32 @@ def _rank_one(loaded: list[tuple[pathlib.Path, dict]], physics: str) -> Leaderbo
   )
 
 
-def decimals_of(value: float) -> int:
-  """2 decimals from 1 up; below 1, enough for 3 significant digits."""
-  if value == 0 or abs(value) >= 1:
-    return 2
-  return max(2, 2 - math.floor(math.log10(abs(value))))
+ORACLE_PLACE = "oracle"  # The place column of an oracle's row (agents.is_oracle): not ranked.
 
 
-def number(value: float, decimals: int | None = None) -> str:
-  """A figure as the leaderboard prints it, with ``decimals`` (default: ``decimals_of(value)``)."""
-  return f"{value:.{decimals_of(value) if decimals is None else decimals}f}"
+def places(entries: tuple[Entry, ...]) -> list[str]:
+  """The place of each of a group's ranked ``entries``: 1, 2, ... and ``ORACLE_PLACE`` for an
+  oracle, which ranks after every other agent and takes no place."""
+  shown, place = [], 0
+  for entry in entries:
+    if agents.is_oracle(entry.setting[0]):
+      shown.append(ORACLE_PLACE)
+    else:
+      place += 1
+      shown.append(str(place))
+  return shown
+
+
+decimals_of = metrics.decimals_of
+number = metrics.number
 
 
 def mean_and_std(estimate: Estimate) -> str:
-  """``mean ± std``, both with the decimals of the mean."""
-  decimals = decimals_of(estimate.mean)
-  return f"{number(estimate.mean, decimals)} ± {number(estimate.std, decimals)}"
+  """``mean ± std``, both with the decimals of the mean; the mean alone where there is no
+  standard deviation."""
+  if estimate.std is None:
+    return number(estimate.mean)
+  return metrics.mean_and_std(estimate.mean, estimate.std)
 
 
 def cell(estimate: Estimate | None) -> str:

@@ -64,9 +64,9 @@ def table(group: ranking.Group) -> str:
   header = ["#", "agent", "profile", "eval", "seeds"]
   header += [ranking.METRIC_LABELS[name] for name in group.metrics]
   rows = [header]
-  for place, entry in enumerate(group.entries, start=1):
+  for place, entry in zip(ranking.places(group.entries), group.entries):
     rows.append(
-      [str(place), *entry.shown_setting, str(entry.record["seeds"])]
+      [place, *entry.shown_setting, str(entry.record["seeds"])]
       + [ranking.cell(entry.estimates.get(name)) for name in group.metrics]
     )
   lines = [group.title, *("  " + line for line in _aligned(rows, right={0, 4}))]
