@@ -29,6 +29,7 @@ from softbench.leaderboard import filters
 from softbench.leaderboard import log_chart
 from softbench.leaderboard import overview
 from softbench.leaderboard import ranking
+from softbench.leaderboard import verified
 from softbench.leaderboard import winners
 
 
@@ -651,3 +652,49 @@ def test_a_run_prints_micrometres_in_full(real_record):
   printed = run.table(tiny)
   assert 0 < np.mean(means) < 0.01 and "0.00 ± 0.00" not in printed
   assert metrics.mean_and_std(float(np.mean(means)), float(np.std(means))) in printed
+
+
+def test_only_records_the_ledger_holds_as_they_are_are_verified(real_record, tmp_path):
+  # A forged record (scores edited, its hash recomputed) is accepted as a record, never verified.
+  folder = tmp_path / "results"
+  records.write(variant(real_record, agent="smpl"), folder / "smpl.json")
+  records.write(variant(real_record, agent="lstm"), folder / "lstm.json")
+  loaded = dict(records.read_folder(folder))
+  outcomes = {
+    path.name: verified.Outcome(record, "2026-12-06T00:00:00+00:00", {"processor": "x"}, [0, 1])
+    for path, record in loaded.items()
+  }
+  outcomes["lstm.json"].seeds = [0]  # Partly re-scored (--quick): not verified.
+  verified.write(folder, outcomes)
+  board = leaderboard.build(folder)
+  assert board.verified == {"smpl.json"}
+  records.write(variant(real_record, agent="smpl", scale=0.5), folder / "smpl.json")  # Forged.
+  board = leaderboard.build(folder)
+  assert board.verified == frozenset()
+  leaderboard.write(board, folder, tmp_path / "site")
+  rows = list(csv.DictReader((tmp_path / "site" / csv_table.FILE_NAME).open()))
+  assert {row["agent"]: row["verified"] for row in rows} == {"smpl": "false", "lstm": "false"}
+  page = (tmp_path / "site" / "index.html").read_text()
+  assert page.count(f'title="{leaderboard.html_page.UNVERIFIED_TITLE}">no</td>') == 2
+
+
+@pytest.mark.parametrize(
+  "new,old,agrees",
+  [
+    ({"a": 6.686426005855, "n": 3}, {"a": 6.686426117895, "n": 3}, True),  # Two CPU kinds.
+    ({"a": 6.69}, {"a": 6.68}, False),
+    ({"a": 1.0, "n": 3}, {"a": 1.0, "n": 4}, False),
+    ({"a": [1.0, 2.0]}, {"a": [1.0]}, False),
+    ({"a": 1.0}, {"a": 1.0, "b": 0.0}, False),
+    ({"a": 0.0}, {"a": 0.0}, True),
+  ],
+)
+def test_a_rescored_figure_agrees_within_the_stated_tolerance(new, old, agrees):
+  assert verified.agrees(new, old)[0] is agrees
+
+
+def test_a_damaged_ledger_is_one_line(tmp_path):
+  (tmp_path / "results").mkdir()
+  verified.path_for(tmp_path / "results").write_text("[")
+  with pytest.raises(ValueError, match=r"verified.json: not a verification ledger \("):
+    leaderboard.build(tmp_path / "results")

@@ -12,6 +12,7 @@ from smpl import training
 from softbench import agents
 from softbench import cli
 from softbench import evaluation
+from softbench import leaderboard
 from softbench import profiles
 from softbench import protocols
 from softbench import records
@@ -19,6 +20,7 @@ from softbench import suite
 from softbench import zoo
 from softbench.agents import learned
 from softbench.data import dataset as data_files
+from softbench.leaderboard import verified
 from softbench.leaderboard import zoo_catalogue as catalogue
 from softbench.robots import versions
 
@@ -338,14 +340,17 @@ def test_cli_run_add_and_verify_reproduce_a_record_from_the_zoo(
     cli.main(["zoo", "verify", "--results", str(tmp_path / "results"), "--zoo", str(folder)]) == 0
   )
   out = capsys.readouterr().out
-  assert out.count("identical (") == 2 and "2 of 2 re-scored seeds identical" in out
+  assert out.count("identical (") == 2 and "2 of 2 re-scored seeds agree" in out
+  board = leaderboard.build(tmp_path / "results")
+  assert board.verified == {path.name}  # In the ledger beside the results: verified.
   assert (
     cli.main(
       ["zoo", "verify", "--quick", "--results", str(tmp_path / "results"), "--zoo", str(folder)]
     )
     == 0
   )
-  assert "1 of 1 re-scored seeds identical" in capsys.readouterr().out
+  assert "1 of 1 re-scored seeds agree" in capsys.readouterr().out
+  assert verified.read(tmp_path / "results")[path.name]["seeds"] == [0, 1]  # Quick: kept.
 
 
 def test_verify_reports_a_record_the_zoo_does_not_reproduce(babbled, tmp_path, monkeypatch, capsys):
@@ -384,6 +389,7 @@ def test_verify_reports_a_record_the_zoo_does_not_reproduce(babbled, tmp_path, m
   )
   captured = capsys.readouterr()
   assert "DIFFERS: differs in mean_reward" in captured.out
+  assert verified.read(tmp_path / "results") == {}  # Not verified.
   assert _without_reference_lines(captured.err) == [
     "softbench: error: 1 re-scored seeds differ from their records"
   ]

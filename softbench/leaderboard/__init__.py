@@ -8,7 +8,8 @@ profiles), ``exp1s_board`` (Exp1S records in the paper's layout, beside the pape
 ``filters`` (the records of some robots, tasks, agents or profiles, for a partial printout),
 ``markdown_page`` and ``html_page`` (``README.md`` and ``index.html``, the latter from the Jinja2
 template in ``templates/``, with ``log_chart``'s log-axis bar charts), ``csv_table``
-(``leaderboard.csv``: every shown row), ``doc_tables`` (the results tables of the repository's
+(``leaderboard.csv``: every shown row), ``verified`` (the records the zoo's weights re-score),
+``doc_tables`` (the results tables of the repository's
 ``README.md`` and ``docs/*.md``). The record formats themselves are ``softbench.records``'.
 """
 
@@ -23,6 +24,7 @@ from softbench.leaderboard import html_page
 from softbench.leaderboard import markdown_page
 from softbench.leaderboard import ranking
 from softbench.leaderboard import text
+from softbench.leaderboard import verified
 
 DEFAULT_RESULTS = records.DEFAULT_FOLDER
 DEFAULT_OUT = pathlib.Path("leaderboard")
@@ -40,7 +42,7 @@ def build(
   loaded = records.read_folder(results)
   if record_filter is not None:
     loaded = [(path, record) for path, record in loaded if record_filter.keeps(record)]
-  return ranking.rank(loaded)
+  return ranking.rank(loaded, verified.verified(results, loaded))
 
 
 def write(

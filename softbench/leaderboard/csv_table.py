@@ -5,6 +5,7 @@ over seeds; the current physics' rows first, then each earlier version's.
 
 Figures are written in full (``repr``), not rounded as the pages show them; a metric the record
 does not hold, or an interval with fewer than ``ranking.MIN_SEEDS_FOR_INTERVAL`` seeds, is empty.
+``verified`` is ``true`` where the zoo's weights re-score the record (``verified``).
 """
 
 import csv
@@ -23,6 +24,7 @@ HEADER = (
   *(f"{metric}_{statistic}" for metric in records.METRICS for statistic in _STATISTICS),
   "record",
   "video",
+  "verified",
 )
 
 
@@ -53,4 +55,5 @@ def _write_rows(writer, board: ranking.Leaderboard, out: pathlib.Path) -> None:
       for metric in records.METRICS:
         row += _figures(entry.estimates.get(metric))
       row += [links.record(entry, out), links.video(entry, out) or ""]
+      row.append("true" if board.is_verified(entry) else "false")
       writer.writerow(row)

@@ -98,6 +98,8 @@ def _figure(
 
 
 BEST_TITLE = "the best learned agent on this task"
+VERIFIED_TITLE = "the zoo's weights re-score this record (softbench zoo verify)"
+UNVERIFIED_TITLE = "not re-scored from the zoo: its figures rest on the submitter alone"
 ORACLE_NOTE = "oracle: uses the simulator itself (a bound on what the physics allows), not ranked"
 
 
@@ -108,9 +110,12 @@ def _metric_caption(metric: str) -> str:
   )
 
 
-def _task_boards(group: ranking.Group, out: pathlib.Path, prefix: str = "") -> tuple[Board, ...]:
-  """``group``'s rows split by profile and eval mode, each ranked, with a chart per metric;
-  ``prefix`` begins each board's anchor (an earlier physics version's section)."""
+def _task_boards(
+  group: ranking.Group, out: pathlib.Path, board: ranking.Leaderboard, prefix: str = ""
+) -> tuple[Board, ...]:
+  """``group``'s rows split by profile and eval mode, each ranked, with a chart per metric and
+  each record's verification (``board.is_verified``); ``prefix`` begins each board's anchor (an
+  earlier physics version's section)."""
   by_setting: dict[tuple[str, str], list[ranking.Entry]] = {}
   for entry in group.entries:  # Already ranked.
     by_setting.setdefault(entry.setting[1:], []).append(entry)
@@ -121,6 +126,7 @@ def _task_boards(group: ranking.Group, out: pathlib.Path, prefix: str = "") -> t
     ("seeds", True),
     *((ranking.METRIC_LABELS[metric], True) for metric in group.metrics),
     *((("video", False),) if videos else ()),
+    ("verified", False),
     ("record", False),
   )
   boards = []
@@ -138,6 +144,9 @@ def _task_boards(group: ranking.Group, out: pathlib.Path, prefix: str = "") -> t
           Cell(str(entry.record["seeds"]), entry.record["seeds"]),
           *(_figure(entry.estimates.get(metric)) for metric in group.metrics),
           *(((Cell("video", href=video) if video else Cell("-")),) if videos else ()),
+          Cell("✓", title=VERIFIED_TITLE)
+          if board.is_verified(entry)
+          else Cell("no", title=UNVERIFIED_TITLE),
           Cell("json", href=links.record(entry, out), title=entry.path.name),
         )
       )
@@ -353,7 +362,7 @@ def _earlier(board: ranking.Leaderboard, out: pathlib.Path) -> Earlier:
     board.physics_description,
     board.record_count,
     board.latest_date,
-    [(group, _task_boards(group, out, prefix)) for group in board.groups],
+    [(group, _task_boards(group, out, board, prefix)) for group in board.groups],
     board.exp1s,
   )
 
@@ -374,7 +383,7 @@ def render(board: ranking.Leaderboard, results: pathlib.Path, out: pathlib.Path)
     ],
     about_paper=overview.about_paper(),
     across=_by_robot((view.robot, _aggregate_board(view)) for view in aggregate.views(board)),
-    task_groups=[(group, _task_boards(group, out)) for group in board.groups],
+    task_groups=[(group, _task_boards(group, out, board)) for group in board.groups],
     exp1s=board.exp1s,
     physics=board.physics_description,
     earlier=[_earlier(older, out) for older in board.earlier],

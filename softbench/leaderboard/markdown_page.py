@@ -165,13 +165,15 @@ def _earlier_anchor(board: ranking.Leaderboard) -> str:
   return f"physics-{board.physics}"
 
 
-def _table(group: ranking.Group, out: pathlib.Path, physics: str = "") -> list[str]:
+def _table(
+  group: ranking.Group, out: pathlib.Path, board: ranking.Leaderboard, physics: str = ""
+) -> list[str]:
   """The ranked rows of ``group``; ``physics`` names an earlier version's board in the title
   and anchor."""
   header = (
     ["#", "agent", "profile", "eval", "seeds"]
     + [ranking.METRIC_LABELS[name] for name in group.metrics]
-    + ["video", "record"]
+    + ["video", "verified", "record"]
   )
   lines = [
     f'<a id="{physics}{"-" if physics else ""}{group.anchor}"></a>',
@@ -186,7 +188,8 @@ def _table(group: ranking.Group, out: pathlib.Path, physics: str = "") -> list[s
     cells = (
       [place, *map(_escaped, entry.shown_setting), str(entry.record["seeds"])]
       + [ranking.cell(entry.estimates.get(name)) for name in group.metrics]
-      + [_link("video", video) if video else "-", _link(entry.path.name, links.record(entry, out))]
+      + [_link("video", video) if video else "-", "✓" if board.is_verified(entry) else "no"]
+      + [_link(entry.path.name, links.record(entry, out))]
     )
     lines.append("| " + " | ".join(cells) + " |")
   lines.append("")
@@ -257,7 +260,7 @@ def render(board: ranking.Leaderboard, results: pathlib.Path, out: pathlib.Path)
   lines = _intro(board, (*views, *across), results_link)
   lines += _overviews(views) + _across(across)
   for group in board.groups:
-    lines += _table(group, out)
+    lines += _table(group, out, board)
   for group in board.exp1s:
     lines += _exp1s_group(group, out)
   for older in board.earlier:
@@ -278,7 +281,7 @@ def _earlier(board: ranking.Leaderboard, out: pathlib.Path) -> list[str]:
     "",
   ]
   for group in board.groups:
-    lines += _table(group, out, board.physics)
+    lines += _table(group, out, board, board.physics)
   for group in board.exp1s:
     lines += _exp1s_group(group, out, board.physics)
   return lines

@@ -181,6 +181,12 @@ class Leaderboard:
   exp1s: tuple[exp1s_board.Group, ...] = ()  # Of softbench run --protocol exp1s records.
   physics: str = versions.LATEST  # The physics version of every record on the board.
   earlier: tuple["Leaderboard", ...] = ()  # The records of earlier physics versions, oldest first.
+  verified: frozenset[str] = frozenset()  # File names of the records the zoo re-scored (verified).
+
+  def is_verified(self, entry: "Entry") -> bool:
+    """Whether ``entry``'s record is in the verification ledger as it is now
+    (``softbench.leaderboard.verified``)."""
+    return entry.path.name in self.verified
 
   @property
   def physics_description(self) -> str:
@@ -238,19 +244,25 @@ def _moment(record: dict) -> datetime.datetime:
   return datetime.datetime.fromisoformat(record["date"])  # Checked, with a time zone.
 
 
-def rank(loaded: list[tuple[pathlib.Path, dict]]) -> Leaderboard:
+def rank(
+  loaded: list[tuple[pathlib.Path, dict]], verified: frozenset[str] = frozenset()
+) -> Leaderboard:
   """The leaderboard of checked records (``records.read_folder``) of every kind: the records of
   the newest physics version among them (the installed one if there are none), with a board of
-  its own for each earlier version's."""
+  its own for each earlier version's; ``verified``: the file names of the records the zoo's
+  weights re-scored (``softbench.leaderboard.verified``)."""
   by_physics: dict[str, list] = {}
   for path, record in loaded:
     by_physics.setdefault(record_fields.physics_of(record), []).append((path, record))
   order = list(versions.VERSIONS)
   newest = max(by_physics, key=order.index, default=versions.current().name)
   earlier = tuple(
-    _rank_one(by_physics[name], name) for name in order if name in by_physics and name != newest
+    dataclasses.replace(_rank_one(by_physics[name], name), verified=verified)
+    for name in order
+    if name in by_physics and name != newest
   )
-  return dataclasses.replace(_rank_one(by_physics.get(newest, []), newest), earlier=earlier)
+  newest_board = _rank_one(by_physics.get(newest, []), newest)
+  return dataclasses.replace(newest_board, earlier=earlier, verified=verified)
 
 
 def _rank_one(loaded: list[tuple[pathlib.Path, dict]], physics: str) -> Leaderboard:

@@ -1,6 +1,8 @@
 """``softbench zoo verify``: re-scores committed records from the zoo's weights alone, in an
-empty data home, and compares every figure with the record's (``verify``; ``verify_zoo`` checks
-the zoo first and prints what it finds)."""
+empty data home, and compares every figure with the record's within ``verified.RELATIVE_TOLERANCE``
+(``verify``; ``verify_zoo`` checks the zoo first and prints what it finds); the records whose
+every seed agrees go into the verification ledger that the pages mark records by
+(``softbench.leaderboard.verified``)."""
 
 from collections.abc import Iterator
 import contextlib
@@ -19,7 +21,9 @@ from softbench import robots
 from softbench import run as run_module
 from softbench import storage
 from softbench import zoo
+from softbench.leaderboard import verified
 from softbench.records import fields as record_fields
+from softbench.records import provenance
 from softbench.robots import versions
 
 
@@ -29,14 +33,21 @@ class Check:
 
   record: str
   seed: int
-  identical: bool
-  detail: str  # What differs, or how the record could not be re-scored; '' when identical.
+  agrees: bool  # Every figure within verified.RELATIVE_TOLERANCE of the record's.
+  detail: str  # What differs, or how the record could not be re-scored; '' when it agrees.
   seconds: float
+  difference: float = 0.0  # The largest relative difference of a figure.
 
   def describe(self) -> str:
-    """One line: ``RECORD seed N: identical (12.3 s)``, or ``DIFFERS: ...`` and what differs."""
-    verdict = "identical" if self.identical else f"DIFFERS: {self.detail}"
-    return f"{self.record} seed {self.seed}: {verdict} ({self.seconds:.1f} s)"
+    """One line: ``RECORD seed N: identical (12.3 s)``, ``agrees (largest relative difference
+    2.1e-08; 12.3 s)``, or ``DIFFERS: ...`` and what differs."""
+    if not self.agrees:
+      verdict = f"DIFFERS: {self.detail} ({self.seconds:.1f} s)"
+    elif self.difference == 0:
+      verdict = f"identical ({self.seconds:.1f} s)"
+    else:
+      verdict = f"agrees (largest relative difference {self.difference:.1e}; {self.seconds:.1f} s)"
+    return f"{self.record} seed {self.seed}: {verdict}"
 
 
 class ZooMismatch(RuntimeError):
@@ -126,8 +137,12 @@ def verify(
 ) -> list[Check]:
   """Re-scores ``planned`` records of the installed physics version in an empty data home, one
   seed at a time, and compares each seed's figures with the record's; ``report(check)`` sees
-  each check as it ends. Records of another physics version are left out (``other_physics``)."""
+  each check as it ends. Records of another physics version are left out (``other_physics``).
+  After each check the ledger (``verified.write``) holds what is known, so an interrupted
+  verification keeps what it found."""
   found = {path.name: record for path, record in records.read_folder(results)}
+  machine = provenance.provenance("cpu")
+  outcomes: dict[str, verified.Outcome] = {}
   checks = []
   for name, seed in planned(zoo_folder, agents, quick):
     if name in other_physics(found):
@@ -144,14 +159,23 @@ def verify(
     else:
       with empty_data_home():
         new = rescored(record, seed)
-      identical = new == stored
+      agreed, difference = verified.agrees(new, stored)
       check = Check(
         name,
         seed,
-        identical,
-        "" if identical else _difference(new, stored),
+        agreed,
+        "" if agreed else _difference(new, stored),
         time.perf_counter() - started,
+        difference if agreed else 0.0,
       )
+      outcome = outcomes.setdefault(
+        name, verified.Outcome(record, machine["date"], machine["machine"])
+      )
+      if agreed:
+        outcome.seeds.append(seed)
+        outcome.difference = max(outcome.difference, difference)
+      outcome.disagreed |= not agreed
+      verified.write(results, outcomes)
     checks.append(check)
     if report is not None:
       report(check)
@@ -203,8 +227,12 @@ def verify_zoo(
   checks = verify(
     results, zoo_folder, agents, quick, lambda check: print(check.describe(), flush=True)
   )
-  differing = sum(not check.identical for check in checks)
-  print(f"{len(checks) - differing} of {len(checks)} re-scored seeds identical to their records")
+  differing = sum(not check.agrees for check in checks)
+  print(
+    f"{len(checks) - differing} of {len(checks)} re-scored seeds agree with their records "
+    f"(every figure within {verified.RELATIVE_TOLERANCE:g} relative); verified records: "
+    f"{verified.path_for(results)}"
+  )
   if differing:
     raise ZooMismatch(f"{differing} re-scored seeds differ from their records")
   return checks
