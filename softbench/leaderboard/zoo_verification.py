@@ -25,6 +25,7 @@ from softbench.leaderboard import verified
 from softbench.records import fields as record_fields
 from softbench.records import provenance
 from softbench.robots import versions
+from softbench.suite import references as suite_references
 
 
 @dataclasses.dataclass(frozen=True)
@@ -50,16 +51,23 @@ class Check:
     return f"{self.record} seed {self.seed}: {verdict}"
 
 
+REFERENCES_FOLDER = suite_references.FOLDER  # In a data home.
+
+
 class ZooMismatch(RuntimeError):
   """``softbench zoo verify`` found a record that the zoo's weights do not reproduce."""
 
 
 @contextlib.contextmanager
-def empty_data_home() -> Iterator[pathlib.Path]:
+def empty_data_home(references: pathlib.Path | None = None) -> Iterator[pathlib.Path]:
   """Within the block the data home is a new empty folder, so that nothing trained or collected
-  before is reused."""
+  before is reused; ``references``: a folder of reference trajectories simulated during this
+  verification, shared by its checks (simulated from the physics alone, no weights; tendon-3's
+  take about 30 s each)."""
   previous = os.environ.get(storage.HOME_VARIABLE)
   with tempfile.TemporaryDirectory(prefix="softbench-zoo-verify-") as home:
+    if references is not None:
+      (pathlib.Path(home) / REFERENCES_FOLDER).symlink_to(references, target_is_directory=True)
     os.environ[storage.HOME_VARIABLE] = home
     try:
       yield pathlib.Path(home)
@@ -144,41 +152,43 @@ def verify(
   machine = provenance.provenance("cpu")
   outcomes: dict[str, verified.Outcome] = {}
   checks = []
-  for name, seed in planned(zoo_folder, agents, quick):
-    if name in other_physics(found):
-      continue
-    started = time.perf_counter()
-    record = found.get(name)
-    stored = (
-      None
-      if record is None
-      else next((entry for entry in record["per_seed"] if entry["seed"] == seed), None)
-    )
-    if stored is None:
-      check = Check(name, seed, False, "no such record or seed in " + str(results), 0.0)
-    else:
-      with empty_data_home():
-        new = rescored(record, seed)
-      agreed, difference = verified.agrees(new, stored)
-      check = Check(
-        name,
-        seed,
-        agreed,
-        "" if agreed else _difference(new, stored),
-        time.perf_counter() - started,
-        difference if agreed else 0.0,
+  with tempfile.TemporaryDirectory(prefix="softbench-zoo-verify-references-") as shared:
+    shared_references = pathlib.Path(shared)
+    for name, seed in planned(zoo_folder, agents, quick):
+      if name in other_physics(found):
+        continue
+      started = time.perf_counter()
+      record = found.get(name)
+      stored = (
+        None
+        if record is None
+        else next((entry for entry in record["per_seed"] if entry["seed"] == seed), None)
       )
-      outcome = outcomes.setdefault(
-        name, verified.Outcome(record, machine["date"], machine["machine"])
-      )
-      if agreed:
-        outcome.seeds.append(seed)
-        outcome.difference = max(outcome.difference, difference)
-      outcome.disagreed |= not agreed
-      verified.write(results, outcomes)
-    checks.append(check)
-    if report is not None:
-      report(check)
+      if stored is None:
+        check = Check(name, seed, False, "no such record or seed in " + str(results), 0.0)
+      else:
+        with empty_data_home(shared_references):
+          new = rescored(record, seed)
+        agreed, difference = verified.agrees(new, stored)
+        check = Check(
+          name,
+          seed,
+          agreed,
+          "" if agreed else _difference(new, stored),
+          time.perf_counter() - started,
+          difference if agreed else 0.0,
+        )
+        outcome = outcomes.setdefault(
+          name, verified.Outcome(record, machine["date"], machine["machine"])
+        )
+        if agreed:
+          outcome.seeds.append(seed)
+          outcome.difference = max(outcome.difference, difference)
+        outcome.disagreed |= not agreed
+        verified.write(results, outcomes)
+      checks.append(check)
+      if report is not None:
+        report(check)
   return checks
 
 

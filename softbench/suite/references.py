@@ -46,6 +46,7 @@ LEAD_IN = 0.05  # Fraction of the steps over which circle and rectangle grow fro
 AMPLITUDE_GRID = np.linspace(0.05, 1.0, 20)  # Actuations tried when calibrating the amplitude.
 SETTLE_SECONDS = 3.0  # (s) Hold per calibration actuation; longer than any settling time.
 FORMAT_VERSION = 1
+FOLDER = "references"  # In the data home.
 
 
 def _phases(length: int, cycles: float) -> np.ndarray:
@@ -244,7 +245,7 @@ def reference(robot: base.SoftArm, shape: str, length: int = REFERENCE_LENGTH) -
   _check_shape(shape)
   config = _config(robot, shape, length)
   key = hashlib.sha256(json.dumps(config, sort_keys=True).encode()).hexdigest()[:12]
-  path = storage.softbench_home() / "references" / f"{robot.name}-{shape}-n{length}-{key}.npz"
+  path = storage.softbench_home() / FOLDER / f"{robot.name}-{shape}-n{length}-{key}.npz"
   cached = _load_cached(path, config)
   if cached is not None:
     return cached
