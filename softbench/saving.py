@@ -2,10 +2,10 @@
 
 A runner (``softbench.run``, ``softbench.continual``, ``softbench.retrain``) returns a record from
 its ``execute`` and offers ``table(record)`` and ``record_path(record, results)``; ``save`` prints
-the table, writes the record (checked, sealed and atomic: ``records.write``) under the results
-folder and to an extra copy if asked, and says where. What only one runner does afterwards (its
-plots, a video, discarding the finished seeds it kept for resuming) follows, once the record is
-safe.
+the table, writes the record (checked, sealed and atomic, never over another record:
+``records.write_new``) under the results folder and to an extra copy if asked, and says where.
+What only one runner does afterwards (its plots, a video, discarding the finished seeds it kept
+for resuming) follows, once the record is safe.
 """
 
 import os
@@ -29,8 +29,7 @@ def save(
   """Prints ``runner``'s table of ``record``, writes it under ``results`` (and to ``copy``);
   returns the files written, the results folder's first."""
   print(runner.table(record))
-  path = runner.record_path(record, results)
-  records.write(record, path)
+  path = records.write_new(record, runner.record_path(record, results))
   print(f"result record: {path}")
   if copy is not None:
     records.write(record, copy)

@@ -2,7 +2,8 @@
 
 The data home is ``$SOFTBENCH_HOME`` if set, else ``$XDG_CACHE_HOME/softbench`` (by default
 ``~/.cache/softbench``). Every file goes through a temporary file in the same folder and an
-``os.replace``, so a reader sees the old file or the new one, never half of one.
+``os.replace``, so a reader sees the old file or the new one, never half of one; a file that
+must not replace another (a result record) goes in with a hard link instead (``write_new``).
 """
 
 from collections.abc import Callable
@@ -14,6 +15,7 @@ import hashlib
 import io
 import os
 import pathlib
+import secrets
 import sys
 import tempfile
 from typing import TypeVar
@@ -46,6 +48,37 @@ def write_atomically(path: pathlib.Path, content: str | bytes) -> None:
   (``smpl.files.write_atomically``). A failed write removes the temporary file and raises
   its error, naming ``path`` (a full disk says which file it could not write)."""
   files.write_atomically(path, content)
+
+
+def write_new(path: pathlib.Path, content: str | bytes) -> bool:
+  """Writes ``content`` to ``path`` unless something is there already, whole or not at all: a
+  complete temporary file in the same folder is hard-linked to ``path`` (a link never replaces a
+  file; a rename would). False, writing nothing, where ``path`` exists. Where the file system has
+  no hard links, ``path`` is claimed empty (``O_EXCL``) and then replaced by the whole file."""
+  path = pathlib.Path(path)
+  temporary = path.with_name(f".{path.name}.{secrets.token_hex(4)}.new")
+  try:
+    write_atomically(temporary, content)
+    try:
+      os.link(temporary, path)
+    except FileExistsError:
+      return False
+    except OSError:  # No hard links here (some network and FAT file systems).
+      if not _claimed(path):
+        return False
+      os.replace(temporary, path)
+  finally:
+    temporary.unlink(missing_ok=True)
+  return True
+
+
+def _claimed(path: pathlib.Path) -> bool:
+  """Whether this process created ``path``, empty; False where it exists."""
+  try:
+    os.close(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+  except FileExistsError:
+    return False
+  return True
 
 
 @contextlib.contextmanager

@@ -1,0 +1,43 @@
+"""Runs side by side and cut short, and inputs that are not what they seem: records of the same
+second kept apart, one reference computation per data home, an interrupt after the record is
+written, special files and links as inputs and outputs, counts too large to hold, names that
+would leave their folder, and environment variables that name the wrong thing."""
+
+import os
+import pathlib
+
+import pytest
+
+from softbench import records
+from softbench import run
+from softbench import saving
+from softbench import storage
+
+COMMITTED_RESULTS = pathlib.Path(__file__).resolve().parents[1] / records.DEFAULT_FOLDER
+
+
+@pytest.fixture
+def committed_record() -> dict:
+  """A committed ``softbench run`` record, as read from the repository's results."""
+  return records.read(min(COMMITTED_RESULTS.glob("zero-pneumatic-433-circle-default-*.json")))
+
+
+def test_records_of_the_same_second_are_kept_apart(committed_record, tmp_path, capsys):
+  # Two runs that finished in the same second wrote one file name: the second replaced the first.
+  first = saving.save(run, committed_record, tmp_path)[0]
+  second = saving.save(run, committed_record, tmp_path)[0]
+  assert first == run.record_path(committed_record, tmp_path)
+  assert second == first.with_name(f"{first.stem}-2.json")
+  assert sorted(tmp_path.iterdir()) == sorted([first, second])
+  assert records.read(first) == records.read(second) == committed_record
+  assert f"result record: {second}" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("hard_links", [True, False], ids=["linked", "claimed"])
+def test_a_new_file_never_replaces_one(hard_links, tmp_path, monkeypatch):
+  if not hard_links:  # A file system without hard links (os.link fails as on FAT).
+    monkeypatch.setattr(os, "link", lambda *_: (_ for _ in ()).throw(PermissionError(1, "no")))
+  path = tmp_path / "record.json"
+  assert storage.write_new(path, "first")
+  assert not storage.write_new(path, "second")
+  assert path.read_text() == "first" and sorted(tmp_path.iterdir()) == [path]
