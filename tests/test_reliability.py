@@ -5,15 +5,21 @@ would leave their folder, and environment variables that name the wrong thing.""
 
 import os
 import pathlib
+import select
+import subprocess
+import sys
 
 import pytest
 
 from softbench import records
+from softbench import robots
 from softbench import run
 from softbench import saving
 from softbench import storage
+from softbench.suite import references
 
 COMMITTED_RESULTS = pathlib.Path(__file__).resolve().parents[1] / records.DEFAULT_FOLDER
+CHILD_DEADLINE_S = 120  # (s) A child program still running after this has hung.
 
 
 @pytest.fixture
@@ -41,3 +47,37 @@ def test_a_new_file_never_replaces_one(hard_links, tmp_path, monkeypatch):
   assert storage.write_new(path, "first")
   assert not storage.write_new(path, "second")
   assert path.read_text() == "first" and sorted(tmp_path.iterdir()) == [path]
+
+
+_REFERENCE_PROGRAM = """
+from softbench import robots
+from softbench.suite import references
+references.recorder.from_rest = None  # Generating it here fails: the waiting process reads it.
+print(references.reference(robots.make("tendon-1"), "babbling", 5).poses.shape)
+"""
+
+
+def test_one_reference_computation_per_data_home(tmp_path, monkeypatch):
+  # Two runs of one setting both computed its reference.
+  monkeypatch.setenv(storage.HOME_VARIABLE, str(tmp_path))
+  other = None
+  from_rest = references.recorder.from_rest
+
+  def recorded_while_another_process_asks(*args):
+    nonlocal other
+    other = subprocess.Popen(
+      [sys.executable, "-c", _REFERENCE_PROGRAM], stdout=subprocess.PIPE, stderr=subprocess.PIPE
+    )
+    said, _, _ = select.select([other.stderr], [], [], CHILD_DEADLINE_S)
+    assert said and b"waiting for another process making the reference" in other.stderr.readline()
+    return from_rest(*args)
+
+  monkeypatch.setattr(references.recorder, "from_rest", recorded_while_another_process_asks)
+  try:
+    made = references.reference(robots.make("tendon-1"), "babbling", 5)
+    out, error = other.communicate(timeout=CHILD_DEADLINE_S)
+  finally:
+    if other is not None:
+      other.kill()  # A no-op once it has ended.
+  assert other.returncode == 0, error
+  assert out.decode() == f"{made.poses.shape}\n"
