@@ -120,8 +120,13 @@ def _run_protocol(args: argparse.Namespace) -> None:
   record = continual.execute(
     settings.profile, settings.seeds, workers=args.workers, keep_seeds=True, family=settings.family
   )
-  files = saving.save(continual, record, pathlib.Path(args.results), _json_copy(args))
-  continual.finish(record, files)
+  saving.save(
+    continual,
+    record,
+    pathlib.Path(args.results),
+    _json_copy(args),
+    lambda files: continual.finish(record, files),
+  )
 
 
 def _video_request(args: argparse.Namespace, path: str):
@@ -171,8 +176,13 @@ def _run(args: argparse.Namespace) -> None:
     raise ValueError("--video renders one seed's episode; --adaptive draws its own figure")
   video_request = _video_request(args, args.video) if args.video else None
   record, episodes = run_module.execute_episodes(settings, keep_seeds=True, workers=args.workers)
-  files = saving.save(run_module, record, pathlib.Path(args.results), _json_copy(args))
-  run_module.finish(settings, record, files, episodes, video_request)
+  saving.save(
+    run_module,
+    record,
+    pathlib.Path(args.results),
+    _json_copy(args),
+    lambda files: run_module.finish(settings, record, files, episodes, video_request),
+  )
 
 
 def _render(args: argparse.Namespace) -> None:
@@ -899,6 +909,9 @@ _RUN_FAILURES = (
 )
 
 
+_RUN_COMPLETE = ("softbench.saving:RunComplete",)  # An interrupt once the record was written.
+
+
 def _imported_classes(names: tuple[str, ...]) -> tuple[type[BaseException], ...]:
   """The classes ``names`` ("module:class") of the modules imported so far. An error of a module
   never imported cannot have been raised, so catching only these loads nothing more."""
@@ -941,6 +954,13 @@ def main(argv: list[str] | None = None) -> int:
       file=sys.stderr,
     )
     return EXIT_FAILURE
+  except _imported_classes(_RUN_COMPLETE) as complete:
+    print(
+      f"softbench: interrupted once the run was complete: its result record is {complete.path}"
+      " (what follows the record, a copy, plots or a video, may be missing)",
+      file=sys.stderr,
+    )
+    return EXIT_INTERRUPTED
   except KeyboardInterrupt:
     print("softbench: interrupted; run the same command again to resume", file=sys.stderr)
     return EXIT_INTERRUPTED

@@ -6,16 +6,22 @@ would leave their folder, and environment variables that name the wrong thing.""
 import os
 import pathlib
 import select
+import signal
 import subprocess
 import sys
+import time
 
 import pytest
 
+from softbench import cli
+from softbench import episode_snapshots
+from softbench import plots
 from softbench import records
 from softbench import robots
 from softbench import run
 from softbench import saving
 from softbench import storage
+from softbench import terminal
 from softbench.suite import references
 
 COMMITTED_RESULTS = pathlib.Path(__file__).resolve().parents[1] / records.DEFAULT_FOLDER
@@ -81,3 +87,39 @@ def test_one_reference_computation_per_data_home(tmp_path, monkeypatch):
       other.kill()  # A no-op once it has ended.
   assert other.returncode == 0, error
   assert out.decode() == f"{made.poses.shape}\n"
+
+
+def _killed(*_) -> None:
+  """``kill`` of this process, as from another terminal; the handler raises at once."""
+  os.kill(os.getpid(), signal.SIGTERM)
+  time.sleep(CHILD_DEADLINE_S)
+
+
+def test_an_interrupt_once_the_record_is_written_leaves_a_complete_run(
+  tmp_path, monkeypatch, run_wide_home, capsys
+):
+  # It said "interrupted; run the same command again to resume", and the rerun wrote a second
+  # record of the same run.
+  run_wide_home("tendon-1")
+  monkeypatch.setattr(plots, "save_run_plots", _killed)
+  argv = ["run", "--task", "circle", "--agent", "zero", "--robot", "tendon-1", "--profile", "tiny"]
+  assert cli.main([*argv, "--seeds", "1", "--results", str(tmp_path)]) == cli.EXIT_INTERRUPTED
+  (path,) = tmp_path.glob("*.json")
+  error = capsys.readouterr().err
+  assert error.startswith(
+    f"softbench: interrupted once the run was complete: its result record is {path} ("
+  )
+  assert error.count("\n") == 1 and records.read(path)["seeds"] == 1
+  settings = run.settings("circle", "zero", "tendon-1", 1, "tiny")
+  assert not episode_snapshots.folder(settings).exists()  # Nothing left to resume from.
+
+
+def test_an_interrupt_during_a_held_step_waits_for_its_end():
+  steps = []
+  with terminal.sigterm_as_interrupt(), pytest.raises(KeyboardInterrupt):
+    with terminal.interrupts_held():
+      os.kill(os.getpid(), signal.SIGTERM)
+      time.sleep(0.1)
+      steps.append("written")
+    steps.append("after")
+  assert steps == ["written"]
