@@ -16,6 +16,7 @@ import io
 import os
 import pathlib
 import secrets
+import stat
 import sys
 import tempfile
 from typing import TypeVar
@@ -152,15 +153,22 @@ def check_writable(path: str | os.PathLike, what: str, folder: bool = False) -> 
   ``folder``, a folder of files) whose missing parent folders can be made. Checked before long
   work, so that it does not end in a failed write.
 
+  A file must be a regular file or nothing: a link, a device or a FIFO there would be replaced
+  (``--json /dev/stdout``, run as root, replaced the system's link). A folder may be a link to
+  one.
+
   Raises:
-    ValueError: ``path`` is a folder where a file is wanted or the other way round, a parent is
-      a file, or there is no permission to write (one line).
+    ValueError: ``path`` is not a folder where one is wanted, or not a regular file where a file
+      is, a parent is a file, or there is no permission to write (one line).
   """
   path = pathlib.Path(path)
-  if path.exists() and path.is_dir() != folder:
-    raise ValueError(
-      f"cannot write {what} {str(path)!r}: it is {'a file' if folder else 'a folder'}"
-    )
+  try:
+    mode = (os.stat if folder else os.lstat)(path).st_mode
+  except OSError:  # Nothing there (or a folder that cannot be looked into: said below).
+    mode = None
+  if mode is not None and not (stat.S_ISDIR(mode) if folder else stat.S_ISREG(mode)):
+    wanted = "a folder" if folder else "a regular file"
+    raise ValueError(f"cannot write {what} {str(path)!r}: it is {file_kind(mode)}, not {wanted}")
   ancestor = path.absolute() if folder else path.absolute().parent
   while not ancestor.exists():
     ancestor = ancestor.parent
@@ -181,6 +189,22 @@ def check_writable(path: str | os.PathLike, what: str, folder: bool = False) -> 
       f"({error.strerror or first_line(error)})"
     ) from None
   return path
+
+
+_FILE_KINDS = (
+  (stat.S_ISREG, "a file"),
+  (stat.S_ISDIR, "a folder"),
+  (stat.S_ISLNK, "a symbolic link"),
+  (stat.S_ISFIFO, "a FIFO"),
+  (stat.S_ISCHR, "a character device"),
+  (stat.S_ISBLK, "a block device"),
+  (stat.S_ISSOCK, "a socket"),
+)
+
+
+def file_kind(mode: int) -> str:
+  """What a file of ``mode`` (an ``os.stat`` result's ``st_mode``) is, e.g. "a FIFO"."""
+  return next((kind for test, kind in _FILE_KINDS if test(mode)), "a special file")
 
 
 def check_home() -> pathlib.Path:

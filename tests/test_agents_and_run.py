@@ -1,8 +1,10 @@
 """Every registered agent on a small task set with the tiny profile, and ``softbench run``."""
 
 import json
+import os
 import pathlib
 import shutil
+import stat
 import warnings
 
 from dm_control.rl import control
@@ -405,6 +407,11 @@ def test_video_flags_without_a_video_are_refused(command, flags, capsys, tmp_pat
     (["--results", "a-file/records"], "is not a folder"),
     (["--json", "a-folder"], "it is a folder"),
     (["--json", "a-file/record.json"], "is not a folder"),
+    # A FIFO, a device and a link were replaced by a regular file.
+    (["--json", "a-fifo"], "it is a FIFO, not a regular file"),
+    (["--json", "a-device"], "it is a character device, not a regular file"),
+    (["--json", "a-link"], "it is a symbolic link, not a regular file"),
+    (["--results", "a-fifo"], "it is a FIFO, not a folder"),
   ],
 )
 @pytest.mark.parametrize(
@@ -422,10 +429,18 @@ def test_outputs_that_cannot_be_written_are_refused_before_the_run(
   monkeypatch.chdir(tmp_path)
   (tmp_path / "a-file").write_text("")
   (tmp_path / "a-folder").mkdir()
+  os.mkfifo(tmp_path / "a-fifo")
+  (tmp_path / "a-link").symlink_to(tmp_path / "a-file")
+  if "a-device" in outputs:  # A device of its own: a broken check must not replace /dev/null.
+    try:
+      os.mknod(tmp_path / "a-device", stat.S_IFCHR | 0o666, os.makedev(1, 3))
+    except PermissionError:
+      pytest.skip("making a device takes root")
   assert cli.main([*command, "--profile", "tiny", *outputs]) == cli.EXIT_USAGE
   lines = capsys.readouterr().err.strip().splitlines()
   assert len(lines) == 1 and message in lines[0], lines
   assert not (tmp_path / "home").exists()
+  assert stat.S_ISFIFO(os.lstat(tmp_path / "a-fifo").st_mode) and (tmp_path / "a-link").is_symlink()
 
 
 def test_a_data_home_that_cannot_be_used_is_one_line(capsys, tmp_path, monkeypatch):
