@@ -207,6 +207,19 @@ def file_kind(mode: int) -> str:
   return next((kind for test, kind in _FILE_KINDS if test(mode)), "a special file")
 
 
+def check_regular_file(path: str | os.PathLike, what: str) -> None:
+  """Refuses to read ``what`` (e.g. "trajectory file") from ``path`` unless it is a regular file
+  (or a link to one): a FIFO would wait for a writer forever, a device never end.
+
+  Raises:
+    FileNotFoundError: nothing is there.
+    ValueError: something other than a regular file is there (one line naming it).
+  """
+  mode = os.stat(path).st_mode
+  if not stat.S_ISREG(mode):
+    raise ValueError(f"{what} {path} is {file_kind(mode)}, not a regular file")
+
+
 def check_home() -> pathlib.Path:
   """The data home, once it is known to take files; checked before any work that caches.
 

@@ -328,6 +328,7 @@ def _bad_trajectories(folder: pathlib.Path) -> dict[str, tuple[str, str]]:
   (folder / "empty.csv").write_text("")
   np.save(folder / "complex.npy", np.ones((3, 12), dtype=complex))
   (folder / "a-folder.csv").mkdir()
+  os.mkfifo(folder / "a-fifo.npy")  # Was reported as missing.
   # Finite but absurd: positions of 1e300 m once ran every episode, printed inf ± nan and failed
   # writing the record, leaving saved seeds that failed the same way on every rerun.
   pose = np.array([0.0, 0.0, -0.05, 0.0, 0.0, -1.0])
@@ -346,11 +347,12 @@ def _bad_trajectories(folder: pathlib.Path) -> dict[str, tuple[str, str]]:
     "empty": ("empty.csv", "trajectory"),
     "complex": ("complex.npy", "real numbers"),
     "folder": ("a-folder.csv", "is a folder"),
+    "fifo": ("a-fifo.npy", "is a FIFO, not a regular file"),
   }
 
 
 @pytest.mark.parametrize(
-  "case", ["missing", "wrong shape", "empty", "complex", "folder", "far", "long axis"]
+  "case", ["missing", "wrong shape", "empty", "complex", "folder", "fifo", "far", "long axis"]
 )
 def test_a_bad_trajectory_is_refused_before_any_collection_or_training(
   case, capsys, tmp_path, monkeypatch

@@ -3,6 +3,7 @@ second kept apart, one reference computation per data home, an interrupt after t
 written, special files and links as inputs and outputs, counts too large to hold, names that
 would leave their folder, and environment variables that name the wrong thing."""
 
+import contextlib
 import os
 import pathlib
 import select
@@ -123,3 +124,30 @@ def test_an_interrupt_during_a_held_step_waits_for_its_end():
       steps.append("written")
     steps.append("after")
   assert steps == ["written"]
+
+
+@contextlib.contextmanager
+def _deadline(seconds: int):
+  """Within the block, a wait longer than ``seconds`` fails the test instead of hanging it."""
+
+  def expired(*_):
+    raise TimeoutError(f"still waiting after {seconds} s")
+
+  previous = signal.signal(signal.SIGALRM, expired)
+  signal.alarm(seconds)
+  try:
+    yield
+  finally:
+    signal.alarm(0)
+    signal.signal(signal.SIGALRM, previous)
+
+
+def test_a_fifo_among_the_records_is_refused_not_waited_on(committed_record, tmp_path, capsys):
+  # softbench leaderboard waited forever for a writer.
+  records.write(committed_record, tmp_path / "good.json")
+  os.mkfifo(tmp_path / "x.json")
+  with _deadline(30):
+    assert cli.main(["leaderboard", "--results", str(tmp_path)]) == cli.EXIT_USAGE
+  assert capsys.readouterr().err == (
+    f"softbench: error: {tmp_path / 'x.json'}: a FIFO, not a regular file\n"
+  )

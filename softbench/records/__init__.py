@@ -28,6 +28,7 @@ import json
 import math
 import os
 import pathlib
+import stat
 
 import jsonschema
 from jsonschema import exceptions as schema_exceptions
@@ -248,12 +249,15 @@ def read(path: pathlib.Path) -> dict:
   """The checked record in ``path``.
 
   Raises:
-    RecordError: the file is not valid JSON or not a valid, untouched record, or is a broken
-      link (one line).
+    RecordError: the file is not valid JSON or not a valid, untouched record, a broken link, or
+      not a regular file (a FIFO, a device; one line).
     FileNotFoundError: no such file.
   """
   path = pathlib.Path(path)
   try:
+    mode = os.stat(path).st_mode
+    if not stat.S_ISREG(mode):  # A FIFO would be waited on forever.
+      raise RecordError(f"{path}: {storage.file_kind(mode)}, not a regular file")
     record = json.loads(path.read_text(encoding="utf-8"))
     validate(record, str(path))
   except FileNotFoundError:

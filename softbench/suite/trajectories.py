@@ -17,6 +17,7 @@ import warnings
 
 import numpy as np
 
+from softbench import storage
 from softbench.robots import base
 from softbench.robots import recorder
 
@@ -133,10 +134,10 @@ def as_given(given, robot: base.SoftArm) -> Given | None:
 
 
 def _read(path: pathlib.Path) -> np.ndarray:
-  if path.is_dir():
-    raise ValueError(f"trajectory file {path} is a folder")
-  if not path.is_file():
-    raise ValueError(f"trajectory file {path} does not exist")
+  try:  # A FIFO would wait for a writer forever: named as what it is.
+    storage.check_regular_file(path, "trajectory file")
+  except FileNotFoundError:
+    raise ValueError(f"trajectory file {path} does not exist") from None
   try:
     if path.suffix == ".npy":
       return np.load(path, allow_pickle=False)
