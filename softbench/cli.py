@@ -22,6 +22,7 @@ from softbench import terminal
 
 EXIT_USAGE = 2
 _JSON_HELP = "print JSON (for scripts) instead of a table"
+_SEEDS_HELP = f"number of seeds, at most {profiles.MAX_SEEDS:,} (default: the profile's)"
 EXIT_FAILURE = 1  # The run itself failed (not the input).
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it.
 # The video flags (``_add_video_arguments``) by attribute: ``VideoOptions`` fields.
@@ -457,8 +458,8 @@ def _tune_arguments(parser: argparse.ArgumentParser) -> None:
     "--trials",
     type=int,
     default=tuning.DEFAULT_TRIALS,
-    help=f"finished trials the study should hold (default {tuning.DEFAULT_TRIALS}); "
-    "re-running adds the missing ones",
+    help=f"finished trials the study should hold, at most {tuning.MAX_TRIALS:,} (default "
+    f"{tuning.DEFAULT_TRIALS}); re-running adds the missing ones",
   )
   parser.add_argument(
     "--storage", help="Optuna storage URL (default: sqlite:///$SOFTBENCH_HOME/tuning.db)"
@@ -519,7 +520,7 @@ def _run_arguments(parser: argparse.ArgumentParser) -> None:
   parser.add_argument(
     "--robot", help="default: the task's robot in the paper (tendon-3; pneumatic-433 for reach)"
   )
-  parser.add_argument("--seeds", type=int, help="number of seeds (default: the profile's)")
+  parser.add_argument("--seeds", type=int, help=_SEEDS_HELP)
   parser.add_argument(
     "--workers",
     type=int,
@@ -548,7 +549,8 @@ def _run_arguments(parser: argparse.ArgumentParser) -> None:
   parser.add_argument(
     "--targets",
     type=int,
-    help=f"virtual targets of --adaptive (default {adaptive.DEFAULT_TARGETS})",
+    help=f"virtual targets of --adaptive, at most {adaptive.MAX_TARGETS:,} "
+    f"(default {adaptive.DEFAULT_TARGETS})",
   )
   parser.add_argument(
     "--helpers",
@@ -596,7 +598,7 @@ def _sweep_arguments(parser: argparse.ArgumentParser) -> None:
     f"(default {exp1s_records.DEFAULT_FAMILY})",
   )
   _add_profile_argument(parser)
-  parser.add_argument("--seeds", type=int, help="number of seeds (default: the profile's)")
+  parser.add_argument("--seeds", type=int, help=_SEEDS_HELP)
   parser.add_argument(
     "--eval",
     nargs="+",
@@ -696,7 +698,7 @@ def _retrain_arguments(parser: argparse.ArgumentParser) -> None:
     default=retrain_module.DEFAULT_BASELINE,
     help=f"centralised baseline retrained from scratch (default {retrain_module.DEFAULT_BASELINE})",
   )
-  parser.add_argument("--seeds", type=int, help="number of seeds (default: the profile's)")
+  parser.add_argument("--seeds", type=int, help=_SEEDS_HELP)
   _add_profile_argument(parser)
   _add_record_arguments(parser)
 
@@ -713,7 +715,11 @@ def _add_zoo_setting_arguments(parser: argparse.ArgumentParser) -> None:
     "--family",
     help=f"with --protocol {exp1s_records.PROTOCOL}: one of {', '.join(robots.TENDON_FAMILIES)}",
   )
-  parser.add_argument("--seeds", type=int, help="seeds 0 .. N-1 (default: the profile's)")
+  parser.add_argument(
+    "--seeds",
+    type=int,
+    help=f"seeds 0 .. N-1, N at most {profiles.MAX_SEEDS:,} (default: the profile's)",
+  )
   parser.add_argument(
     "--seed",
     type=int,

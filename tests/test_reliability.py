@@ -12,18 +12,23 @@ import subprocess
 import sys
 import time
 
+import numpy as np
 import pytest
 
 from softbench import cli
+from softbench import continual
 from softbench import episode_snapshots
 from softbench import plots
 from softbench import records
+from softbench import retrain
 from softbench import robots
 from softbench import run
 from softbench import saving
 from softbench import storage
 from softbench import terminal
+from softbench import tuning
 from softbench.suite import references
+from softbench.sweep import grid as sweep_grid
 
 COMMITTED_RESULTS = pathlib.Path(__file__).resolve().parents[1] / records.DEFAULT_FOLDER
 CHILD_DEADLINE_S = 120  # (s) A child program still running after this has hung.
@@ -59,6 +64,7 @@ def test_a_new_file_never_replaces_one(hard_links, tmp_path, monkeypatch):
 _REFERENCE_PROGRAM = """
 from softbench import robots
 from softbench.suite import references
+from softbench.sweep import grid as sweep_grid
 references.recorder.from_rest = None  # Generating it here fails: the waiting process reads it.
 print(references.reference(robots.make("tendon-1"), "babbling", 5).poses.shape)
 """
@@ -151,3 +157,84 @@ def test_a_fifo_among_the_records_is_refused_not_waited_on(committed_record, tmp
   assert capsys.readouterr().err == (
     f"softbench: error: {tmp_path / 'x.json'}: a FIFO, not a regular file\n"
   )
+
+
+HUGE = "99999999999999999999"  # A count that filled the memory or hung the command.
+TINY_RUN = ["--agent", "zero", "--robot", "tendon-1", "--profile", "tiny"]
+
+
+@pytest.fixture
+def no_work(monkeypatch):
+  """Every command's work fails the test: a count must be refused before any starts."""
+
+  def started(*_, **__):
+    raise AssertionError("work started")
+
+  for module, name in (
+    (run, "execute_episodes"),
+    (continual, "execute"),
+    (retrain, "execute"),
+    (sweep_grid, "existing_record"),  # A sweep's first step once its settings are checked.
+    (tuning, "tune"),
+  ):
+    monkeypatch.setattr(module, name, started)
+
+
+@pytest.mark.parametrize(
+  "argv,message",
+  [
+    (["run", "--task", "circle", *TINY_RUN, "--seeds", HUGE], "seeds must be at most 1,000"),
+    (["run", "--protocol", "exp1s", "--agent", "smpl", "--seeds", HUGE], "seeds must be at most"),
+    (
+      ["run", "--task", "reach", *TINY_RUN[2:], "--agent", "smpl", "--adaptive", "--targets", HUGE],
+      "targets must be at most 10,000",
+    ),
+    (
+      [
+        "sweep",
+        "--robots",
+        "tendon-1",
+        "--tasks",
+        "circle",
+        "--agents",
+        "zero",
+        "--dry-run",
+        "--seeds",
+        HUGE,
+      ],
+      "seeds must be at most",
+    ),
+    (["retrain", "--robot", "tendon-2", "--fault", "2:0:0", "--seeds", HUGE], "seeds must be at"),
+    (["zoo", "add", "--agent", "smpl", "--robot", "tendon-1", "--seeds", HUGE], "seeds must be"),
+    (["zoo", "add", "--agent", "smpl", "--robot", "tendon-1", "--seed", HUGE], "seed must be"),
+    (["zoo", "remove", "--agent", "smpl", "--robot", "tendon-1", "--seeds", HUGE], "seeds must"),
+    (["tune", "--agent", "lstm", "--robot", "tendon-1", "--trials", HUGE], "trials must be at"),
+  ],
+)
+def test_a_count_too_large_is_refused_before_any_work(
+  argv, message, no_work, tmp_path, monkeypatch, capsys
+):
+  monkeypatch.setenv(storage.HOME_VARIABLE, str(tmp_path / "home"))
+  monkeypatch.chdir(tmp_path)
+  assert cli.main(argv) == cli.EXIT_USAGE
+  error = capsys.readouterr().err
+  assert error.startswith(f"softbench: error: {message}") and error.count("\n") == 1, error
+
+
+@pytest.mark.parametrize(
+  "shape,data_bytes,message",
+  [((10**11, 6), 480, "claims 100,000,000,000 rows"), ((1000, 6), 480, "more than the file's")],
+)
+def test_an_npy_trajectory_is_refused_from_its_header(
+  shape, data_bytes, message, no_work, tmp_path, capsys
+):
+  # A header claiming shape (1e11, 6) was an _ArrayMemoryError traceback.
+  path = tmp_path / "claimed.npy"
+  with open(path, "wb") as file:
+    header = {"descr": "<f8", "fortran_order": False, "shape": shape}
+    np.lib.format.write_array_header_1_0(file, header)
+    file.write(bytes(data_bytes))
+  argv = ["run", "--task", "custom", *TINY_RUN, "--trajectory", str(path)]
+  assert cli.main([*argv, "--results", str(tmp_path)]) == cli.EXIT_USAGE
+  error = capsys.readouterr().err
+  assert error.count("\n") == 1 and "is unreadable: its header" in error and message in error

@@ -38,9 +38,11 @@ from softbench import robots
 from softbench import storage
 from softbench.agents import hyperparameters
 from softbench.agents import learned
+from softbench.data import dataset
 from softbench.tuning import report
 
 DEFAULT_TRIALS = 10  # Trials per study, the same for every agent (docs/tuning.md: budget).
+MAX_TRIALS = 10_000  # Of a study: each trains a model; fewer than _SEED_STRIDE keeps seeds apart.
 DATABASE = "tuning.db"  # Default SQLite storage, under the data home.
 SUMMARY_FOLDER = "tuning"  # Study summaries, under the data home.
 _TPE_STARTUP_TRIALS = 4  # Trials sampled at random (the previous values among them) before TPE.
@@ -110,9 +112,9 @@ def settings(
   """Checked study settings; the storage is opened once to check that it can be.
 
   Raises:
-    ValueError: an unknown or non-learning agent, an unknown robot or profile, fewer than one
-      trial, epochs outside 1 .. the profile's, an empty study name or a storage that cannot be
-      opened (one line).
+    ValueError: an unknown or non-learning agent, an unknown robot or profile, trials outside
+      1 .. ``MAX_TRIALS``, epochs outside 1 .. the profile's, an empty study name or a storage
+      that cannot be opened (one line).
   """
   if agents.learner(agent) is None:
     raise ValueError(
@@ -121,8 +123,7 @@ def settings(
     )
   robots.make(robot)
   chosen_profile = profiles.get(profile)
-  if isinstance(trials, bool) or not isinstance(trials, int) or trials < 1:
-    raise ValueError(f"trials must be a whole number of at least 1, got {trials!r}")
+  dataset.check_count("trials", trials, MAX_TRIALS)
   epochs = chosen_profile.max_epochs if epochs is None else epochs
   if (
     isinstance(epochs, bool)
