@@ -238,3 +238,38 @@ def test_an_npy_trajectory_is_refused_from_its_header(
   assert cli.main([*argv, "--results", str(tmp_path)]) == cli.EXIT_USAGE
   error = capsys.readouterr().err
   assert error.count("\n") == 1 and "is unreadable: its header" in error and message in error
+
+
+TINY_TUNE = ["tune", "--agent", "lstm", "--robot", "tendon-1", "--profile", "tiny"]
+
+
+@pytest.mark.parametrize(
+  "study,message",
+  [
+    ("../../../tmp/x", "must be a plain name"),  # Wrote its summary outside the data home.
+    ("sub/study", "must be a plain name"),
+    ("..", "must be a plain name"),
+    ("two\nlines", "no control characters"),
+    ("x" * 201, "at most 200 bytes"),
+  ],
+)
+def test_a_study_name_is_a_plain_name(study, message, no_work, tmp_path, monkeypatch, capsys):
+  monkeypatch.setenv(storage.HOME_VARIABLE, str(tmp_path / "home"))
+  assert cli.main([*TINY_TUNE, "--study", study]) == cli.EXIT_USAGE
+  error = capsys.readouterr().err
+  assert error.startswith("softbench: error: the study name") and error.count("\n") == 1
+  assert message in error
+
+
+def test_a_summary_that_cannot_be_written_is_refused_before_the_study(
+  tmp_path, monkeypatch, capsys
+):
+  # A folder given as --summary failed only once the study had run.
+  monkeypatch.setenv(storage.HOME_VARIABLE, str(tmp_path / "home"))
+  monkeypatch.setattr(tuning.study, "run", lambda *_: pytest.fail("the study ran"))
+  assert cli.main([*TINY_TUNE, "--summary", str(tmp_path)]) == cli.EXIT_USAGE
+  error = capsys.readouterr().err
+  assert error == (
+    f"softbench: error: cannot write the study summary {str(tmp_path)!r}: it is a folder, not a "
+    "regular file\n"
+  )
