@@ -321,6 +321,8 @@ def _leaderboard(args: argparse.Namespace) -> None:
     print(" ".join(grid.lists()[args.grid]))
     return
   results = pathlib.Path(args.results)
+  if not results.exists():  # A mistyped folder is no empty leaderboard.
+    raise ValueError(f"no folder of result records at {results}")
   record_filter = filters.RecordFilter(
     *(
       tuple(names or ())
