@@ -19,6 +19,7 @@ import softbench
 from softbench import profiles
 from softbench import storage
 from softbench import terminal
+from softbench import zoo
 
 EXIT_USAGE = 2
 _JSON_HELP = "print JSON (for scripts) instead of a table"
@@ -905,6 +906,7 @@ def _command_named(argv: list[str]) -> str | None:
 
 
 _CACHING_COMMANDS = ("collect", "run", "render", "retrain", "tune")  # They write to the data home.
+_ZOO_COMMANDS = ("run", "render", "retrain", "sweep")  # They take trained weights from the zoo.
 # Errors of a command's modules, as "module:class", that end it with one line: a bad input
 # (EXIT_USAGE, as ValueError does), and a run that failed (EXIT_FAILURE).
 _USAGE_ERRORS = ("softbench.rendering.video:RenderingUnavailable",)
@@ -944,6 +946,8 @@ def main(argv: list[str] | None = None) -> int:
     with terminal.sigterm_as_interrupt():
       if args.command in _CACHING_COMMANDS:  # Before any work: a home that takes no file fails
         storage.check_home()  # at once, not after the first seed.
+      if args.command in _ZOO_COMMANDS:
+        zoo.folder()  # A $SOFTBENCH_ZOO that names no folder: refused before any work.
       args.run(args)
   except (
     ValueError,

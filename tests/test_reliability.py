@@ -27,6 +27,7 @@ from softbench import saving
 from softbench import storage
 from softbench import terminal
 from softbench import tuning
+from softbench import zoo
 from softbench.suite import references
 from softbench.sweep import grid as sweep_grid
 
@@ -272,4 +273,22 @@ def test_a_summary_that_cannot_be_written_is_refused_before_the_study(
   assert error == (
     f"softbench: error: cannot write the study summary {str(tmp_path)!r}: it is a folder, not a "
     "regular file\n"
+  )
+
+
+@pytest.mark.parametrize("kind", ["a file", "missing"])
+def test_a_zoo_variable_that_names_no_folder_is_refused(
+  kind, no_work, tmp_path, monkeypatch, capsys
+):
+  # The zoo was silently not used: its agents trained again.
+  named = tmp_path / "zoo"
+  if kind == "a file":
+    named.write_text("")
+  monkeypatch.setenv(zoo.VARIABLE, str(named))
+  monkeypatch.setenv(storage.HOME_VARIABLE, str(tmp_path / "home"))
+  argv = ["run", "--task", "circle", *TINY_RUN, "--results", str(tmp_path / "results")]
+  assert cli.main(argv) == cli.EXIT_USAGE
+  found = "is a file" if kind == "a file" else "does not exist"
+  assert capsys.readouterr().err.startswith(
+    f"softbench: error: $SOFTBENCH_ZOO={str(named)!r} {found}, not a zoo folder; "
   )
