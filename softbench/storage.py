@@ -30,6 +30,7 @@ from smpl.files import read_cached  # noqa: F401
 from smpl.files import write_cache_file  # noqa: F401  (softbench's caches write through it)
 
 HOME_VARIABLE = "SOFTBENCH_HOME"
+CACHE_VARIABLE = "XDG_CACHE_HOME"  # Its softbench/ is the data home where HOME_VARIABLE is unset.
 LOCKS_FOLDER = ".locks"  # In the data home: ``made_alone``'s lock files.
 _HELD: set[pathlib.Path] = set()  # The lock files this process holds (``made_alone`` nests).
 T = TypeVar("T")
@@ -39,7 +40,7 @@ def softbench_home() -> pathlib.Path:
   """The folder under which datasets, reference trajectories and checkpoints are cached."""
   if os.environ.get(HOME_VARIABLE):
     return pathlib.Path(os.environ[HOME_VARIABLE]).expanduser()
-  cache = os.environ.get("XDG_CACHE_HOME") or pathlib.Path.home() / ".cache"
+  cache = os.environ.get(CACHE_VARIABLE) or pathlib.Path.home() / ".cache"
   return pathlib.Path(cache) / "softbench"
 
 
@@ -226,7 +227,16 @@ def check_home() -> pathlib.Path:
   Raises:
     ValueError: the data home is a file, lies under one, or cannot be written (one line).
   """
-  return check_writable(softbench_home(), f"the data home (${HOME_VARIABLE})", folder=True)
+  return check_writable(softbench_home(), f"the data home ({_home_source()})", folder=True)
+
+
+def _home_source() -> str:
+  """Where the data home's path comes from, as a refusal names it (``softbench_home``)."""
+  if os.environ.get(HOME_VARIABLE):
+    return f"${HOME_VARIABLE}"
+  if os.environ.get(CACHE_VARIABLE):
+    return f"${CACHE_VARIABLE}/softbench"
+  return "~/.cache/softbench"
 
 
 def config_key(config, name: str) -> str:

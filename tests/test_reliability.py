@@ -292,3 +292,16 @@ def test_a_zoo_variable_that_names_no_folder_is_refused(
   assert capsys.readouterr().err.startswith(
     f"softbench: error: $SOFTBENCH_ZOO={str(named)!r} {found}, not a zoo folder; "
   )
+
+
+def test_a_cache_home_that_is_a_file_is_named_as_such(tmp_path, monkeypatch, capsys):
+  # It was reported as $SOFTBENCH_HOME, which was not set.
+  monkeypatch.delenv(storage.HOME_VARIABLE, raising=False)
+  cache = tmp_path / "cache"
+  cache.write_text("")
+  monkeypatch.setenv("XDG_CACHE_HOME", str(cache))
+  assert cli.main(["collect", "--robot", "tendon-1", "--samples", "10"]) == cli.EXIT_USAGE
+  assert capsys.readouterr().err == (
+    f"softbench: error: cannot write the data home ($XDG_CACHE_HOME/softbench) "
+    f"{str(cache / 'softbench')!r}: {str(cache)!r} is not a folder\n"
+  )
