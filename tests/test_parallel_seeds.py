@@ -1,16 +1,15 @@
 """Seeds in worker processes (``softbench.run``): results in order, errors raised, a dead worker
 reported instead of a hang, Ctrl-C or kill stopping every worker."""
 
-import contextlib
 import multiprocessing
 import os
-import pathlib
 import select
 import signal
 import subprocess
 import sys
 import time
 
+import process_tree
 import pytest
 import torch
 
@@ -178,28 +177,7 @@ parallel_seeds.in_processes(test_parallel_seeds.sleep_long, [(0,), (1,)], "sleep
 ORPHANS_DEADLINE_S = 5  # (s) How long a killed parent's workers may outlive it.
 
 
-def _descendants(pid: int) -> set[int]:
-  """The processes under ``pid``, from Linux's /proc (children before their parent dies)."""
-  parents = {}
-  for entry in pathlib.Path("/proc").iterdir():
-    with contextlib.suppress(OSError, ValueError, IndexError):  # Gone meanwhile, or no process.
-      parents[int(entry.name)] = int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1])
-  found, frontier = set(), {pid}
-  while frontier:
-    frontier = {child for child, parent in parents.items() if parent in frontier} - found
-    found |= frontier
-  return found
-
-
-def _alive(pid: int) -> bool:
-  """Whether ``pid`` runs (a zombie, ended but not yet reaped, does not)."""
-  try:
-    return pathlib.Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
-  except OSError:
-    return False
-
-
-@pytest.mark.skipif(not pathlib.Path("/proc/self/stat").exists(), reason="reads Linux's /proc")
+@pytest.mark.skipif(not process_tree.PROC.is_dir(), reason="reads Linux's /proc")
 def test_a_parent_killed_outright_takes_its_workers_with_it():
   # Before workers watched their parent, kill -9 of a softbench run left the fork server, two
   # workers and the resource tracker running for 8.6 minutes and more.
@@ -211,16 +189,11 @@ def test_a_parent_killed_outright_takes_its_workers_with_it():
       started, _, _ = select.select([process.stdout], [], [], CHILD_DEADLINE_S)
       assert started, f"no worker started in {CHILD_DEADLINE_S} s"
       assert process.stdout.readline().strip() == "worker started"
-    left = _descendants(process.pid)
+    left = process_tree.descendants(process.pid)
     assert len(left) >= 3  # The fork server and its two workers, and the resource tracker.
     process.kill()
     process.wait()
-    deadline = time.monotonic() + ORPHANS_DEADLINE_S
-    while time.monotonic() < deadline and any(_alive(pid) for pid in left):
-      time.sleep(0.1)
-    assert not [pid for pid in left if _alive(pid)]
+    assert not process_tree.still_running(left, ORPHANS_DEADLINE_S)
   finally:
     process.kill()  # A no-op once it has ended.
-    for pid in left:  # What the test would otherwise leave running, had it failed.
-      with contextlib.suppress(OSError):
-        os.kill(pid, signal.SIGKILL)
+    process_tree.kill(left)

@@ -13,6 +13,7 @@ import sys
 import time
 
 import numpy as np
+import process_tree
 import pytest
 
 from softbench import cli
@@ -30,6 +31,7 @@ from softbench import tuning
 from softbench import zoo
 from softbench.suite import references
 from softbench.sweep import grid as sweep_grid
+from softbench.sweep import guard
 
 COMMITTED_RESULTS = pathlib.Path(__file__).resolve().parents[1] / records.DEFAULT_FOLDER
 CHILD_DEADLINE_S = 120  # (s) A child program still running after this has hung.
@@ -66,6 +68,7 @@ _REFERENCE_PROGRAM = """
 from softbench import robots
 from softbench.suite import references
 from softbench.sweep import grid as sweep_grid
+from softbench.sweep import guard
 references.recorder.from_rest = None  # Generating it here fails: the waiting process reads it.
 print(references.reference(robots.make("tendon-1"), "babbling", 5).poses.shape)
 """
@@ -305,3 +308,35 @@ def test_a_cache_home_that_is_a_file_is_named_as_such(tmp_path, monkeypatch, cap
     f"softbench: error: cannot write the data home ($XDG_CACHE_HOME/softbench) "
     f"{str(cache / 'softbench')!r}: {str(cache)!r} is not a folder\n"
   )
+
+
+_GUARDED_PROGRAM = """
+import importlib.util, subprocess, sys, time
+spec = importlib.util.spec_from_file_location("guard", {guard!r})
+guard = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(guard)
+tree = subprocess.Popen(["sh", "-c", "sleep 600 & sleep 600"])  # As Ray's head and its agents.
+time.sleep(0.5)
+guard.start({{tree.pid}})
+print("guarded", flush=True)
+time.sleep(600)
+"""
+
+
+@pytest.mark.skipif(not process_tree.PROC.is_dir(), reason="reads Linux's /proc")
+def test_a_local_ray_ends_with_its_driver_killed_outright():
+  # After kill -9 of a sweep, Ray's dashboard and runtime-env agents lived 61 s more.
+  program = _GUARDED_PROGRAM.format(guard=guard.__file__)
+  driver = subprocess.Popen([sys.executable, "-c", program], stdout=subprocess.PIPE, text=True)
+  left = set()
+  try:
+    said, _, _ = select.select([driver.stdout], [], [], CHILD_DEADLINE_S)
+    assert said and driver.stdout.readline() == "guarded\n"
+    left = process_tree.descendants(driver.pid)
+    assert len(left) == 4  # sh, its two sleeps, and the guard.
+    driver.kill()
+    driver.wait()
+    assert not process_tree.still_running(left, 5)
+  finally:
+    driver.kill()  # A no-op once it has ended.
+    process_tree.kill(left)
