@@ -21,9 +21,11 @@ import softbench
 from softbench import profiles
 from softbench import storage
 from softbench import terminal
+from softbench import zoo
 
 EXIT_USAGE = 2
 _JSON_HELP = "print JSON (for scripts) instead of a table"
+_SEEDS_HELP = f"number of seeds, at most {profiles.MAX_SEEDS:,} (default: the profile's)"
 EXIT_FAILURE = 1  # The run itself failed (not the input).
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it.
 # The video flags (``_add_video_arguments``) by attribute: ``VideoOptions`` fields.
@@ -122,8 +124,13 @@ def _run_protocol(args: argparse.Namespace) -> None:
   record = continual.execute(
     settings.profile, settings.seeds, workers=args.workers, keep_seeds=True, family=settings.family
   )
-  files = saving.save(continual, record, pathlib.Path(args.results), _json_copy(args))
-  continual.finish(record, files)
+  saving.save(
+    continual,
+    record,
+    pathlib.Path(args.results),
+    _json_copy(args),
+    lambda files: continual.finish(record, files),
+  )
 
 
 def _video_request(args: argparse.Namespace, path: str):
@@ -173,8 +180,13 @@ def _run(args: argparse.Namespace) -> None:
     raise ValueError("--video renders one seed's episode; --adaptive draws its own figure")
   video_request = _video_request(args, args.video) if args.video else None
   record, episodes = run_module.execute_episodes(settings, keep_seeds=True, workers=args.workers)
-  files = saving.save(run_module, record, pathlib.Path(args.results), _json_copy(args))
-  run_module.finish(settings, record, files, episodes, video_request)
+  saving.save(
+    run_module,
+    record,
+    pathlib.Path(args.results),
+    _json_copy(args),
+    lambda files: run_module.finish(settings, record, files, episodes, video_request),
+  )
 
 
 def _render(args: argparse.Namespace) -> None:
@@ -323,6 +335,8 @@ def _leaderboard(args: argparse.Namespace) -> None:
     print(" ".join(grid.lists()[args.grid]))
     return
   results = pathlib.Path(args.results)
+  if not results.exists():  # A mistyped folder is no empty leaderboard.
+    raise ValueError(f"no folder of result records at {results}")
   record_filter = filters.RecordFilter(
     *(
       tuple(names or ())
@@ -483,8 +497,8 @@ def _tune_arguments(parser: argparse.ArgumentParser) -> None:
     "--trials",
     type=int,
     default=tuning.DEFAULT_TRIALS,
-    help=f"finished trials the study should hold (default {tuning.DEFAULT_TRIALS}); "
-    "re-running adds the missing ones",
+    help=f"finished trials the study should hold, at most {tuning.MAX_TRIALS:,} (default "
+    f"{tuning.DEFAULT_TRIALS}); re-running adds the missing ones",
   )
   parser.add_argument(
     "--storage", help="Optuna storage URL (default: sqlite:///$SOFTBENCH_HOME/tuning.db)"
@@ -545,7 +559,7 @@ def _run_arguments(parser: argparse.ArgumentParser) -> None:
   parser.add_argument(
     "--robot", help="default: the task's robot in the paper (tendon-3; pneumatic-433 for reach)"
   )
-  parser.add_argument("--seeds", type=int, help="number of seeds (default: the profile's)")
+  parser.add_argument("--seeds", type=int, help=_SEEDS_HELP)
   parser.add_argument(
     "--workers",
     type=int,
@@ -574,7 +588,8 @@ def _run_arguments(parser: argparse.ArgumentParser) -> None:
   parser.add_argument(
     "--targets",
     type=int,
-    help=f"virtual targets of --adaptive (default {adaptive.DEFAULT_TARGETS})",
+    help=f"virtual targets of --adaptive, at most {adaptive.MAX_TARGETS:,} "
+    f"(default {adaptive.DEFAULT_TARGETS})",
   )
   parser.add_argument(
     "--helpers",
@@ -622,7 +637,7 @@ def _sweep_arguments(parser: argparse.ArgumentParser) -> None:
     f"(default {exp1s_records.DEFAULT_FAMILY})",
   )
   _add_profile_argument(parser)
-  parser.add_argument("--seeds", type=int, help="number of seeds (default: the profile's)")
+  parser.add_argument("--seeds", type=int, help=_SEEDS_HELP)
   parser.add_argument(
     "--eval",
     nargs="+",
@@ -722,7 +737,7 @@ def _retrain_arguments(parser: argparse.ArgumentParser) -> None:
     default=retrain_module.DEFAULT_BASELINE,
     help=f"centralised baseline retrained from scratch (default {retrain_module.DEFAULT_BASELINE})",
   )
-  parser.add_argument("--seeds", type=int, help="number of seeds (default: the profile's)")
+  parser.add_argument("--seeds", type=int, help=_SEEDS_HELP)
   _add_profile_argument(parser)
   _add_record_arguments(parser)
 
@@ -739,7 +754,11 @@ def _add_zoo_setting_arguments(parser: argparse.ArgumentParser) -> None:
     "--family",
     help=f"with --protocol {exp1s_records.PROTOCOL}: one of {', '.join(robots.TENDON_FAMILIES)}",
   )
-  parser.add_argument("--seeds", type=int, help="seeds 0 .. N-1 (default: the profile's)")
+  parser.add_argument(
+    "--seeds",
+    type=int,
+    help=f"seeds 0 .. N-1, N at most {profiles.MAX_SEEDS:,} (default: the profile's)",
+  )
   parser.add_argument(
     "--seed",
     type=int,
@@ -924,6 +943,7 @@ def _command_named(argv: list[str]) -> str | None:
 
 
 _CACHING_COMMANDS = ("collect", "run", "render", "retrain", "tune")  # They write to the data home.
+_ZOO_COMMANDS = ("run", "render", "retrain", "sweep")  # They take trained weights from the zoo.
 # Errors of a command's modules, as "module:class", that end it with one line: a bad input
 # (EXIT_USAGE, as ValueError does), and a run that failed (EXIT_FAILURE).
 _USAGE_ERRORS = ("softbench.rendering.video:RenderingUnavailable",)
@@ -934,6 +954,9 @@ _RUN_FAILURES = (
   "softbench.leaderboard.zoo_verification:ZooMismatch",
   "softbench.sweep:SweepFailed",
 )
+
+
+_RUN_COMPLETE = ("softbench.saving:RunComplete",)  # An interrupt once the record was written.
 
 
 def _imported_classes(names: tuple[str, ...]) -> tuple[type[BaseException], ...]:
@@ -969,6 +992,8 @@ def main(argv: list[str] | None = None) -> int:
     with terminal.sigterm_as_interrupt():
       if args.command in _CACHING_COMMANDS:  # Before any work: a home that takes no file fails
         storage.check_home()  # at once, not after the first seed.
+      if args.command in _ZOO_COMMANDS:
+        zoo.folder()  # A $SOFTBENCH_ZOO that names no folder: refused before any work.
       args.run(args)
   except (
     ValueError,
@@ -987,6 +1012,13 @@ def main(argv: list[str] | None = None) -> int:
       file=sys.stderr,
     )
     return EXIT_FAILURE
+  except _imported_classes(_RUN_COMPLETE) as complete:
+    print(
+      f"softbench: interrupted once the run was complete: its result record is {complete.path}"
+      " (what follows the record, a copy, plots or a video, may be missing)",
+      file=sys.stderr,
+    )
+    return EXIT_INTERRUPTED
   except KeyboardInterrupt:
     print("softbench: interrupted; run the same command again to resume", file=sys.stderr)
     return EXIT_INTERRUPTED

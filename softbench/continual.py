@@ -117,10 +117,10 @@ def seed_count(profile: profiles.Profile, seeds: int | None) -> int:
   """``seeds``, or the profile's if None.
 
   Raises:
-    ValueError: fewer than one seed (one line).
+    ValueError: fewer than one seed or more than ``profiles.MAX_SEEDS`` (one line).
   """
   seeds = profile.seeds if seeds is None else seeds
-  dataset.check_count("seeds", seeds)
+  dataset.check_count("seeds", seeds, profiles.MAX_SEEDS)
   return seeds
 
 

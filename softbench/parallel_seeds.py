@@ -1,13 +1,14 @@
 """Runs seeds in worker processes: one per core by default, one torch thread each, with one
-progress bar; Ctrl-C or ``kill`` stops the workers with their parent, and a worker that dies
-ends the run with a one-line error (the finished seeds' checkpoints and episodes are reused by
-the next run)."""
+progress bar; Ctrl-C or ``kill`` stops the workers with their parent, a parent killed outright
+(``kill -9``) takes them with it, and a worker that dies ends the run with a one-line error (the
+finished seeds' checkpoints and episodes are reused by the next run)."""
 
 from collections.abc import Iterator
 from concurrent import futures
 import multiprocessing
 import os
 import signal
+import threading
 
 import torch
 
@@ -17,17 +18,39 @@ from softbench import terminal
 from softbench.data import dataset
 
 _POLL_SECONDS = 0.2  # (s) How often the parent looks at its worker processes.
+ORPHANED_EXIT_CODE = 137  # A worker's exit status once its parent is gone: 128 + SIGKILL's 9.
 
 
 def _init_worker(states) -> None:
   """Worker initialiser: one torch thread (the workers fill the cores; torch's default, one thread
   per core in every worker, made a BiLSTM's evaluation step 450 times slower, 930 ms against 2 ms,
-  with the cores busy); Ctrl-C reaches the parent only, which stops the workers itself; warnings
-  print as in the parent; progress bars send their states to the parent's ``states`` queue."""
+  with the cores busy); Ctrl-C reaches the parent only, which stops the workers itself, and the
+  worker ends with its parent (``_exit_with_parent``); warnings print as in the parent; progress
+  bars send their states to the parent's ``states`` queue."""
   torch.set_num_threads(training.CPU_THREADS)
   signal.signal(signal.SIGINT, signal.SIG_IGN)
+  _exit_with_parent()
   terminal.one_line_warnings()
   progress_bars.relay_to(states)
+
+
+def _exit_with_parent() -> None:
+  """Ends this worker process at once when its parent process ends, from a thread that waits
+  for it. A parent killed outright (``kill -9``) cannot terminate its workers: they went on
+  training (and writing checkpoints), then waited for work forever, and the fork server and the
+  resource tracker, which live as long as a worker, with them (8.6 min and more, measured)."""
+  parent = multiprocessing.parent_process()
+  if parent is not None:
+    threading.Thread(
+      target=_exit_after, args=(parent,), name="exit-with-parent", daemon=True
+    ).start()
+
+
+def _exit_after(parent: multiprocessing.process.BaseProcess) -> None:
+  """Waits for ``parent`` to end (its sentinel, a pipe whose other end only the parent holds),
+  then ends this process without clean-up: the work it was doing has no one to report to."""
+  parent.join()
+  os._exit(ORPHANED_EXIT_CODE)
 
 
 def _received(states) -> Iterator[tuple]:

@@ -30,6 +30,8 @@ PROFILES = {
   ),
 }
 DEFAULT_PROFILE = "default"
+MAX_SEEDS = 1_000  # Seeds of one run at most (200 times the paper's 5), checked before any work:
+# a run holds every seed's episode, so a count of 10^20 filled the memory instead of starting.
 
 
 def get(name: str) -> Profile:

@@ -90,7 +90,8 @@ def settings(
   ``given`` as ``suite.trajectories.Given`` text.
 
   Raises:
-    ValueError: unknown task, agent, robot, profile or eval mode, seeds < 1, a trajectory
+    ValueError: unknown task, agent, robot, profile or eval mode, seeds outside 1 ..
+      ``profiles.MAX_SEEDS``, a trajectory
       without the custom task or the custom task without one, an unreadable or malformed
       trajectory file, a module with another task than reach or out of range, adaptive with
       another task than reach, a non-learned agent or more than one seed, targets without
@@ -108,7 +109,7 @@ def settings(
   if adaptive and parsed_faults:
     raise ValueError("--fault and --adaptive do not go together yet")
   seeds = (1 if adaptive else chosen.seeds) if seeds is None else seeds
-  dataset.check_count("seeds", seeds)
+  dataset.check_count("seeds", seeds, profiles.MAX_SEEDS)
   if eval_mode not in learned.ERROR_SOURCES:
     raise ValueError(
       f"unknown eval mode {eval_mode!r}; choose one of {', '.join(learned.ERROR_SOURCES)}"
@@ -167,7 +168,7 @@ def _check_adaptive(
   if targets is not None and not adaptive:
     raise ValueError("--targets goes with --adaptive")
   if targets is not None:
-    dataset.check_count("targets", targets)
+    dataset.check_count("targets", targets, adaptive_activation.MAX_TARGETS)
 
 
 def _helpers(run: RunSettings, helpers: str | None) -> str | None:

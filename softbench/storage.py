@@ -2,7 +2,8 @@
 
 The data home is ``$SOFTBENCH_HOME`` if set, else ``$XDG_CACHE_HOME/softbench`` (by default
 ``~/.cache/softbench``). Every file goes through a temporary file in the same folder and an
-``os.replace``, so a reader sees the old file or the new one, never half of one.
+``os.replace``, so a reader sees the old file or the new one, never half of one; a file that
+must not replace another (a result record) goes in with a hard link instead (``write_new``).
 """
 
 from collections.abc import Callable
@@ -14,6 +15,8 @@ import hashlib
 import io
 import os
 import pathlib
+import secrets
+import stat
 import sys
 import tempfile
 from typing import TypeVar
@@ -27,6 +30,7 @@ from smpl.files import read_cached  # noqa: F401
 from smpl.files import write_cache_file  # noqa: F401  (softbench's caches write through it)
 
 HOME_VARIABLE = "SOFTBENCH_HOME"
+CACHE_VARIABLE = "XDG_CACHE_HOME"  # Its softbench/ is the data home where HOME_VARIABLE is unset.
 LOCKS_FOLDER = ".locks"  # In the data home: ``made_alone``'s lock files.
 _HELD: set[pathlib.Path] = set()  # The lock files this process holds (``made_alone`` nests).
 T = TypeVar("T")
@@ -36,7 +40,7 @@ def softbench_home() -> pathlib.Path:
   """The folder under which datasets, reference trajectories and checkpoints are cached."""
   if os.environ.get(HOME_VARIABLE):
     return pathlib.Path(os.environ[HOME_VARIABLE]).expanduser()
-  cache = os.environ.get("XDG_CACHE_HOME") or pathlib.Path.home() / ".cache"
+  cache = os.environ.get(CACHE_VARIABLE) or pathlib.Path.home() / ".cache"
   return pathlib.Path(cache) / "softbench"
 
 
@@ -46,6 +50,37 @@ def write_atomically(path: pathlib.Path, content: str | bytes) -> None:
   (``smpl.files.write_atomically``). A failed write removes the temporary file and raises
   its error, naming ``path`` (a full disk says which file it could not write)."""
   files.write_atomically(path, content)
+
+
+def write_new(path: pathlib.Path, content: str | bytes) -> bool:
+  """Writes ``content`` to ``path`` unless something is there already, whole or not at all: a
+  complete temporary file in the same folder is hard-linked to ``path`` (a link never replaces a
+  file; a rename would). False, writing nothing, where ``path`` exists. Where the file system has
+  no hard links, ``path`` is claimed empty (``O_EXCL``) and then replaced by the whole file."""
+  path = pathlib.Path(path)
+  temporary = path.with_name(f".{path.name}.{secrets.token_hex(4)}.new")
+  try:
+    write_atomically(temporary, content)
+    try:
+      os.link(temporary, path)
+    except FileExistsError:
+      return False
+    except OSError:  # No hard links here (some network and FAT file systems).
+      if not _claimed(path):
+        return False
+      os.replace(temporary, path)
+  finally:
+    temporary.unlink(missing_ok=True)
+  return True
+
+
+def _claimed(path: pathlib.Path) -> bool:
+  """Whether this process created ``path``, empty; False where it exists."""
+  try:
+    os.close(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+  except FileExistsError:
+    return False
+  return True
 
 
 @contextlib.contextmanager
@@ -119,15 +154,22 @@ def check_writable(path: str | os.PathLike, what: str, folder: bool = False) -> 
   ``folder``, a folder of files) whose missing parent folders can be made. Checked before long
   work, so that it does not end in a failed write.
 
+  A file must be a regular file or nothing: a link, a device or a FIFO there would be replaced
+  (``--json /dev/stdout``, run as root, replaced the system's link). A folder may be a link to
+  one.
+
   Raises:
-    ValueError: ``path`` is a folder where a file is wanted or the other way round, a parent is
-      a file, or there is no permission to write (one line).
+    ValueError: ``path`` is not a folder where one is wanted, or not a regular file where a file
+      is, a parent is a file, or there is no permission to write (one line).
   """
   path = pathlib.Path(path)
-  if path.exists() and path.is_dir() != folder:
-    raise ValueError(
-      f"cannot write {what} {str(path)!r}: it is {'a file' if folder else 'a folder'}"
-    )
+  try:
+    mode = (os.stat if folder else os.lstat)(path).st_mode
+  except OSError:  # Nothing there (or a folder that cannot be looked into: said below).
+    mode = None
+  if mode is not None and not (stat.S_ISDIR(mode) if folder else stat.S_ISREG(mode)):
+    wanted = "a folder" if folder else "a regular file"
+    raise ValueError(f"cannot write {what} {str(path)!r}: it is {file_kind(mode)}, not {wanted}")
   ancestor = path.absolute() if folder else path.absolute().parent
   while not ancestor.exists():
     ancestor = ancestor.parent
@@ -150,13 +192,51 @@ def check_writable(path: str | os.PathLike, what: str, folder: bool = False) -> 
   return path
 
 
+_FILE_KINDS = (
+  (stat.S_ISREG, "a file"),
+  (stat.S_ISDIR, "a folder"),
+  (stat.S_ISLNK, "a symbolic link"),
+  (stat.S_ISFIFO, "a FIFO"),
+  (stat.S_ISCHR, "a character device"),
+  (stat.S_ISBLK, "a block device"),
+  (stat.S_ISSOCK, "a socket"),
+)
+
+
+def file_kind(mode: int) -> str:
+  """What a file of ``mode`` (an ``os.stat`` result's ``st_mode``) is, e.g. "a FIFO"."""
+  return next((kind for test, kind in _FILE_KINDS if test(mode)), "a special file")
+
+
+def check_regular_file(path: str | os.PathLike, what: str) -> None:
+  """Refuses to read ``what`` (e.g. "trajectory file") from ``path`` unless it is a regular file
+  (or a link to one): a FIFO would wait for a writer forever, a device never end.
+
+  Raises:
+    FileNotFoundError: nothing is there.
+    ValueError: something other than a regular file is there (one line naming it).
+  """
+  mode = os.stat(path).st_mode
+  if not stat.S_ISREG(mode):
+    raise ValueError(f"{what} {path} is {file_kind(mode)}, not a regular file")
+
+
 def check_home() -> pathlib.Path:
   """The data home, once it is known to take files; checked before any work that caches.
 
   Raises:
     ValueError: the data home is a file, lies under one, or cannot be written (one line).
   """
-  return check_writable(softbench_home(), f"the data home (${HOME_VARIABLE})", folder=True)
+  return check_writable(softbench_home(), f"the data home ({_home_source()})", folder=True)
+
+
+def _home_source() -> str:
+  """Where the data home's path comes from, as a refusal names it (``softbench_home``)."""
+  if os.environ.get(HOME_VARIABLE):
+    return f"${HOME_VARIABLE}"
+  if os.environ.get(CACHE_VARIABLE):
+    return f"${CACHE_VARIABLE}/softbench"
+  return "~/.cache/softbench"
 
 
 def config_key(config, name: str) -> str:

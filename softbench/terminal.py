@@ -1,5 +1,6 @@
 """The command line's terminal: tables for people (rich), which read as plain lines when piped,
-JSON documents for scripts, warnings in one line, and ``kill`` taken as Ctrl-C."""
+JSON documents for scripts, warnings in one line, ``kill`` taken as Ctrl-C, and both held for a
+step that must not be cut in two."""
 
 from collections.abc import Collection
 from collections.abc import Iterable
@@ -58,6 +59,28 @@ def one_line_warnings() -> None:
 
 def _interrupt(signal_number: int, frame) -> None:
   raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def interrupts_held() -> Iterator[None]:
+  """Within the block (in the main thread), Ctrl-C and ``kill`` wait for its end and then act as
+  they would have: for a step that must not be cut in two (writing a record, and knowing that it
+  is written)."""
+  if threading.current_thread() is not threading.main_thread():
+    yield
+    return
+  arrived = []
+  held = (signal.SIGINT, signal.SIGTERM)
+  previous = {
+    number: signal.signal(number, lambda number, _: arrived.append(number)) for number in held
+  }
+  try:
+    yield
+  finally:
+    for number, handler in previous.items():
+      signal.signal(number, signal.SIG_DFL if handler is None else handler)  # None: set in C.
+  for number in arrived:
+    signal.raise_signal(number)
 
 
 @contextlib.contextmanager

@@ -1,8 +1,10 @@
 """Every registered agent on a small task set with the tiny profile, and ``softbench run``."""
 
 import json
+import os
 import pathlib
 import shutil
+import stat
 import warnings
 
 from dm_control.rl import control
@@ -327,6 +329,7 @@ def _bad_trajectories(folder: pathlib.Path) -> dict[str, tuple[str, str]]:
   (folder / "empty.csv").write_text("")
   np.save(folder / "complex.npy", np.ones((3, 12), dtype=complex))
   (folder / "a-folder.csv").mkdir()
+  os.mkfifo(folder / "a-fifo.npy")  # Was reported as missing.
   # Finite but absurd: positions of 1e300 m once ran every episode, printed inf ± nan and failed
   # writing the record, leaving saved seeds that failed the same way on every rerun.
   pose = np.array([0.0, 0.0, -0.05, 0.0, 0.0, -1.0])
@@ -345,11 +348,12 @@ def _bad_trajectories(folder: pathlib.Path) -> dict[str, tuple[str, str]]:
     "empty": ("empty.csv", "trajectory"),
     "complex": ("complex.npy", "real numbers"),
     "folder": ("a-folder.csv", "is a folder"),
+    "fifo": ("a-fifo.npy", "is a FIFO, not a regular file"),
   }
 
 
 @pytest.mark.parametrize(
-  "case", ["missing", "wrong shape", "empty", "complex", "folder", "far", "long axis"]
+  "case", ["missing", "wrong shape", "empty", "complex", "folder", "fifo", "far", "long axis"]
 )
 def test_a_bad_trajectory_is_refused_before_any_collection_or_training(
   case, capsys, tmp_path, monkeypatch
@@ -406,6 +410,11 @@ def test_video_flags_without_a_video_are_refused(command, flags, capsys, tmp_pat
     (["--results", "a-file/records"], "is not a folder"),
     (["--json", "a-folder"], "it is a folder"),
     (["--json", "a-file/record.json"], "is not a folder"),
+    # A FIFO, a device and a link were replaced by a regular file.
+    (["--json", "a-fifo"], "it is a FIFO, not a regular file"),
+    (["--json", "a-device"], "it is a character device, not a regular file"),
+    (["--json", "a-link"], "it is a symbolic link, not a regular file"),
+    (["--results", "a-fifo"], "it is a FIFO, not a folder"),
   ],
 )
 @pytest.mark.parametrize(
@@ -423,10 +432,18 @@ def test_outputs_that_cannot_be_written_are_refused_before_the_run(
   monkeypatch.chdir(tmp_path)
   (tmp_path / "a-file").write_text("")
   (tmp_path / "a-folder").mkdir()
+  os.mkfifo(tmp_path / "a-fifo")
+  (tmp_path / "a-link").symlink_to(tmp_path / "a-file")
+  if "a-device" in outputs:  # A device of its own: a broken check must not replace /dev/null.
+    try:
+      os.mknod(tmp_path / "a-device", stat.S_IFCHR | 0o666, os.makedev(1, 3))
+    except PermissionError:
+      pytest.skip("making a device takes root")
   assert cli.main([*command, "--profile", "tiny", *outputs]) == cli.EXIT_USAGE
   lines = capsys.readouterr().err.strip().splitlines()
   assert len(lines) == 1 and message in lines[0], lines
   assert not (tmp_path / "home").exists()
+  assert stat.S_ISFIFO(os.lstat(tmp_path / "a-fifo").st_mode) and (tmp_path / "a-link").is_symlink()
 
 
 def test_a_data_home_that_cannot_be_used_is_one_line(capsys, tmp_path, monkeypatch):

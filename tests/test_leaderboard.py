@@ -529,18 +529,25 @@ def test_regenerating_is_deterministic(results, tmp_path, assert_regenerates_ide
   assert_regenerates_identically(results, tmp_path)
 
 
-@pytest.mark.parametrize("make_folder", [False, True])
-def test_write_on_a_missing_or_empty_folder(make_folder, tmp_path, capsys):
+def test_write_on_an_empty_folder(tmp_path, capsys):
   results = tmp_path / "results"
-  if make_folder:
-    results.mkdir()
+  results.mkdir()
   out = tmp_path / "site"
   assert cli.main(["leaderboard", "--results", str(results), "--write", "--out", str(out)]) == 0
   printed = capsys.readouterr().out
-  assert f"no result records in {results}" in printed
-  assert ("an empty folder" if make_folder else "no folder") in printed
+  assert f"no result records in {results}" in printed and "an empty folder" in printed
   for page in ("README.md", "index.html"):
     assert "No result records yet" in (out / page).read_text()
+
+
+@pytest.mark.parametrize("write", [[], ["--write"]], ids=["report", "write"])
+def test_a_missing_results_folder_is_refused(write, tmp_path, capsys):
+  # It printed an empty leaderboard (exit 0), and --write replaced the pages with empty ones.
+  results, out = tmp_path / "results", tmp_path / "site"
+  argv = ["leaderboard", "--results", str(results), *write, "--out", str(out)]
+  assert cli.main(argv) == cli.EXIT_USAGE
+  assert capsys.readouterr().err == f"softbench: error: no folder of result records at {results}\n"
+  assert not out.exists()
 
 
 # Physics versions: never ranked together.

@@ -9,6 +9,7 @@ import subprocess
 import sys
 import time
 
+import process_tree
 import pytest
 import torch
 
@@ -175,3 +176,35 @@ def test_finished_workers_exit_cleanly():
   assert result.returncode == 0, result.stderr
   assert result.stdout.strip().endswith("[2.0, 4.0]")
   assert "leaked" not in result.stderr, result.stderr
+
+
+_KILLED_PROGRAM = """
+import sys
+sys.path.insert(0, {tests!r})
+from softbench import parallel_seeds
+import test_parallel_seeds
+parallel_seeds.in_processes(test_parallel_seeds.sleep_long, [(0,), (1,)], "sleepers", workers=2)
+"""
+ORPHANS_DEADLINE_S = 5  # (s) How long a killed parent's workers may outlive it.
+
+
+@pytest.mark.skipif(not process_tree.PROC.is_dir(), reason="reads Linux's /proc")
+def test_a_parent_killed_outright_takes_its_workers_with_it():
+  # Before workers watched their parent, kill -9 of a softbench run left the fork server, two
+  # workers and the resource tracker running for 8.6 minutes and more.
+  program = _KILLED_PROGRAM.format(tests=os.path.dirname(__file__))
+  process = subprocess.Popen([sys.executable, "-c", program], stdout=subprocess.PIPE, text=True)
+  left = set()
+  try:
+    for _ in range(2):  # Both workers busy.
+      started, _, _ = select.select([process.stdout], [], [], CHILD_DEADLINE_S)
+      assert started, f"no worker started in {CHILD_DEADLINE_S} s"
+      assert process.stdout.readline().strip() == "worker started"
+    left = process_tree.descendants(process.pid)
+    assert len(left) >= 3  # The fork server and its two workers, and the resource tracker.
+    process.kill()
+    process.wait()
+    assert not process_tree.still_running(left, ORPHANS_DEADLINE_S)
+  finally:
+    process.kill()  # A no-op once it has ended.
+    process_tree.kill(left)

@@ -155,7 +155,7 @@ def test_a_failed_record_write_keeps_the_seeds_for_the_next_run(monkeypatch, tmp
     raise OSError(28, "No space left on device", str(path))
 
   with monkeypatch.context() as patch:
-    patch.setattr(records, "write", disk_full)
+    patch.setattr(records, "write_new", disk_full)
     assert cli.main(argv) == cli.EXIT_FAILURE
   assert "No space left on device" in capsys.readouterr().err.strip().splitlines()[-1]
   assert len(list(episode_snapshots.folder(tiny_run()).glob("seed*.npz"))) == SEEDS

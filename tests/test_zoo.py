@@ -463,8 +463,8 @@ def test_a_record_naming_weights_of_a_seed_it_lacks_is_refused(babbled, tmp_path
     (["--protocol", "exp1s", "--robot", ROBOT], "drop --robot"),
     (["--protocol", "exp2s"], "unknown protocol"),
     (["--family", "tendon-local"], "--family goes with --protocol"),
-    (["--agent", "lstm", "--robot", ROBOT, "--seeds", "0"], "at least 1"),
-    (["--agent", "lstm", "--robot", ROBOT, "--seed", "-1"], "at least 0"),
+    (["--agent", "lstm", "--robot", ROBOT, "--seeds", "0"], "seeds must be a positive integer"),
+    (["--agent", "lstm", "--robot", ROBOT, "--seed", "-1"], "seed must be an integer from 0"),
     (["--agent", "lstm", "--robot", ROBOT, "--seeds", "2", "--seed", "1"], "exclude each other"),
     (["--agent", "lstm", "--robot", ROBOT], "nothing of"),  # Trained (add), in the zoo (remove).
   ],

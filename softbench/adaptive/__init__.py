@@ -18,3 +18,4 @@ computes every output, masked the same way.
 """
 
 DEFAULT_TARGETS = 20  # Virtual targets of ``softbench run --adaptive``.
+MAX_TARGETS = 10_000  # Checked before any work: the record holds a section per target.

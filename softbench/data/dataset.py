@@ -48,6 +48,7 @@ from softbench.robots import recorder
 FORMAT = "softbench-babbling-dataset"
 FORMAT_VERSION = 1  # Bump whenever the arrays or the way they are generated change.
 DEFAULT_SAMPLES = 14_000  # SPEC section 4: motor-babbling samples per robot configuration.
+MAX_SHOWN_CHARS = 40  # Of a refused count, so that its refusal stays one short line.
 MAX_SAMPLES = 10_000_000  # Most samples a dataset may have: 700 times the paper's, 3.2 GB of
 # float64 poses and actions for tendon-5 (40 numbers a sample); more is a typo, not a dataset.
 EPISODE_LENGTH = 1_400  # Samples per episode, at most; 14,000 samples make 10 episodes.
@@ -121,10 +122,16 @@ class Dataset:
     return self.poses[start + index : stop + index + 1], self.actions[start:stop]
 
 
-def check_count(name: str, value: int) -> None:
-  """Raises a one-line ValueError unless ``value`` is an integer of at least 1."""
+def check_count(name: str, value: int, maximum: int | None = None) -> None:
+  """Raises a one-line ValueError unless ``value`` is an integer of at least 1 and, where given,
+  at most ``maximum`` (a count that work is sized by, checked before the work starts)."""
+  shown = (
+    repr(value) if len(repr(value)) <= MAX_SHOWN_CHARS else f"{repr(value)[:MAX_SHOWN_CHARS]}..."
+  )
   if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1:
-    raise ValueError(f"{name} must be a positive integer, got {value!r}")
+    raise ValueError(f"{name} must be a positive integer, got {shown}")
+  if maximum is not None and value > maximum:
+    raise ValueError(f"{name} must be at most {maximum:,}, got {shown}")
 
 
 def read_npz(content: bytes, error_type: type[ValueError]) -> dict[str, np.ndarray]:

@@ -14,6 +14,7 @@ from softbench import robots
 from softbench import storage
 from softbench import zoo
 from softbench.agents import learned
+from softbench.data import seeding
 from softbench.records import fields as record_fields
 from softbench.robots import versions
 
@@ -84,18 +85,16 @@ def chosen_seeds(
   ascending), for ``zoo add`` and ``zoo remove``'s ``--seeds N`` and repeatable ``--seed K``.
 
   Raises:
-    ValueError: both given, seeds < 1 or a negative seed (one line).
+    ValueError: both given, seeds outside 1 .. ``profiles.MAX_SEEDS`` or a seed outside the
+      seed range (``seeding.check_seed``; one line).
   """
   if only_seeds:
     if seeds is not None:
       raise ValueError("--seeds N (seeds 0 .. N-1) and --seed K (seed K alone) exclude each other")
-    if min(only_seeds) < 0:
-      raise ValueError(f"a seed is at least 0, got {min(only_seeds)}")
+    for seed in only_seeds:
+      seeding.check_seed(seed)
     return tuple(sorted(set(only_seeds)))
-  seeds = profile.seeds if seeds is None else seeds
-  if seeds < 1:
-    raise ValueError(f"seeds must be at least 1, got {seeds}")
-  return tuple(range(seeds))
+  return tuple(range(continual.seed_count(profile, seeds)))
 
 
 def requested_setting(

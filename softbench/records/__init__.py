@@ -22,11 +22,13 @@ Version 1 records (before the hash) are refused: they cannot be checked.
 from collections.abc import Callable
 import copy
 import dataclasses
+import errno
 import hashlib
 import json
 import math
 import os
 import pathlib
+import stat
 
 import jsonschema
 from jsonschema import exceptions as schema_exceptions
@@ -58,6 +60,7 @@ _OPTIONAL_FIELDS = (
 )
 ADAPTIVE_SECTION = "adaptive"  # softbench run --adaptive: per-target results, no per-seed ones.
 _MEAN_TOLERANCE = 1e-9  # Relative: a seed's mean against the mean of its per-module values.
+MAX_SAME_NAME = 1000  # Records of one setting and second that ``write_new`` names apart.
 _MAX_MESSAGE_CHARS = 160  # Of a schema error's message, so that a refusal stays one line.
 
 
@@ -232,16 +235,38 @@ def write(record: dict, path: pathlib.Path) -> dict:
   return sealed
 
 
+def write_new(record: dict, path: pathlib.Path) -> pathlib.Path:
+  """Seals ``record`` and writes it to ``path`` or, where a file has that name (a run of the same
+  setting that finished in the same second), to the first free ``STEM-2.json``, ``STEM-3.json``,
+  ...: never over a file, even one that another process writes at the same time
+  (``storage.write_new``). Returns the path written.
+
+  Raises:
+    FileExistsError: ``MAX_SAME_NAME`` names are taken.
+  """
+  content = dumps(seal(record))
+  for number in range(1, MAX_SAME_NAME + 1):
+    candidate = path if number == 1 else path.with_name(f"{path.stem}-{number}{path.suffix}")
+    if storage.write_new(candidate, content):
+      return candidate
+  raise FileExistsError(
+    errno.EEXIST, f"{MAX_SAME_NAME} records of this name exist; none written", str(path)
+  )
+
+
 def read(path: pathlib.Path) -> dict:
   """The checked record in ``path``.
 
   Raises:
-    RecordError: the file is not valid JSON or not a valid, untouched record, or is a broken
-      link (one line).
+    RecordError: the file is not valid JSON or not a valid, untouched record, a broken link, or
+      not a regular file (a FIFO, a device; one line).
     FileNotFoundError: no such file.
   """
   path = pathlib.Path(path)
   try:
+    mode = os.stat(path).st_mode
+    if not stat.S_ISREG(mode):  # A FIFO would be waited on forever.
+      raise RecordError(f"{path}: {storage.file_kind(mode)}, not a regular file")
     record = json.loads(path.read_text(encoding="utf-8"))
     validate(record, str(path))
   except FileNotFoundError:

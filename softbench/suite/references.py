@@ -13,8 +13,9 @@ towards a point moving in the planar actuation space of ``SoftArm.planar_action`
 
 References are cached under ``softbench_home()/references``, keyed by a hash of everything that
 generates them (the robot's MJCF included), with a content hash checked on every load; a damaged
-one is reported (``CorruptFileWarning``) and generated again. The generating actions are stored
-for replay checks; tasks show controllers only the poses.
+one is reported (``CorruptFileWarning``) and generated again. Processes sharing a data home
+generate each reference once: the others wait for it (``storage.found_or_made``). The generating
+actions are stored for replay checks; tasks show controllers only the poses.
 """
 
 from collections.abc import Callable
@@ -23,6 +24,7 @@ import functools
 import hashlib
 import json
 import os
+import pathlib
 import sys
 
 import numpy as np
@@ -246,9 +248,14 @@ def reference(robot: base.SoftArm, shape: str, length: int = REFERENCE_LENGTH) -
   config = _config(robot, shape, length)
   key = hashlib.sha256(json.dumps(config, sort_keys=True).encode()).hexdigest()[:12]
   path = storage.softbench_home() / FOLDER / f"{robot.name}-{shape}-n{length}-{key}.npz"
-  cached = _load_cached(path, config)
-  if cached is not None:
-    return cached
+  return storage.found_or_made(
+    path, lambda: _load_cached(path, config), lambda: _generated(robot, config, path), "reference"
+  )
+
+
+def _generated(robot: base.SoftArm, config: dict, path: pathlib.Path) -> Reference:
+  """The reference of ``config`` simulated on ``robot`` (``_simulate``), then cached at ``path``."""
+  shape, length = config["shape"], config["length"]
   actions, poses = _simulate(robot, shape, length)
   arrays = {"actions": actions, "poses": poses}
   storage.write_cache_file(path, storage.npz_bytes(arrays), "cached reference")

@@ -17,6 +17,7 @@ from smpl.files import first_line
 from softbench import episode_snapshots
 from softbench import storage
 from softbench import zoo
+from softbench.sweep import guard
 from softbench.sweep import tasks
 
 COLLECTION_CORES = 4  # (cores) A babbling collection's simulation threads, at most a node's cores.
@@ -30,13 +31,17 @@ _NODE_FACTS = ray.remote(num_cpus=1)(tasks.node_facts)
 @contextlib.contextmanager
 def connected(address: str | None) -> Iterator[None]:
   """Within the block, Ray: the caller's if it started one, else the cluster at ``address``, else
-  a local Ray with one worker per core; left (a local one: shut down) at the end, Ctrl-C too."""
+  a local Ray with one worker per core; left (a local one: shut down) at the end, Ctrl-C too. A
+  local Ray's processes end with this one even when it is killed outright (``guard``)."""
   if ray.is_initialized():
     yield
     return
+  local_ray = None
   if address is None:
+    before = guard.children(os.getpid())
     # "local": a Ray of its own even where RAY_ADDRESS or a running `ray start` names another.
     ray.init(address="local", num_cpus=os.cpu_count(), include_dashboard=False)
+    local_ray = guard.start(guard.children(os.getpid()) - before)  # Ends with this process.
   else:
     _check_answers(address)
     try:
@@ -50,6 +55,7 @@ def connected(address: str | None) -> Iterator[None]:
     yield
   finally:
     ray.shutdown()
+    guard.stop(local_ray)
 
 
 def _check_answers(address: str) -> None:

@@ -142,11 +142,11 @@ def execute(
     wall_time_s = time.perf_counter() - started
     if isinstance(run, continual.RunSettings):
       record = continual.assemble_record(run, origin, in_order, plan.taken[run], wall_time_s)
-      files = saving.save(continual, record, results, None)
+      files = saving.save(continual, record, results, ends_command=False)
       continual.finish(record, files)
     else:
       record = run_module.assemble_record(run, origin, in_order, plan.taken[run], wall_time_s)
-      files = saving.save(run_module, record, results, None)
+      files = saving.save(run_module, record, results, ends_command=False)
       episode_snapshots.discard(run)
     written.append(files[0])
 

@@ -9,6 +9,7 @@ the agent's hyperparameters (``softbench.agents.hyperparameters``); ``tune`` doe
 """
 
 from softbench.tuning.study import DEFAULT_TRIALS
+from softbench.tuning.study import MAX_TRIALS
 from softbench.tuning.study import TuneSettings
 from softbench.tuning.study import adopt
 from softbench.tuning.study import confirm
@@ -21,6 +22,7 @@ from softbench.tuning.study import write_summary
 
 __all__ = [
   "DEFAULT_TRIALS",
+  "MAX_TRIALS",
   "TuneSettings",
   "adopt",
   "confirm",

@@ -38,11 +38,14 @@ from softbench import robots
 from softbench import storage
 from softbench.agents import hyperparameters
 from softbench.agents import learned
+from softbench.data import dataset
 from softbench.tuning import report
 
 DEFAULT_TRIALS = 10  # Trials per study, the same for every agent (docs/tuning.md: budget).
+MAX_TRIALS = 10_000  # Of a study: each trains a model; fewer than _SEED_STRIDE keeps seeds apart.
 DATABASE = "tuning.db"  # Default SQLite storage, under the data home.
 SUMMARY_FOLDER = "tuning"  # Study summaries, under the data home.
+MAX_STUDY_NAME_BYTES = 200  # A study name in UTF-8; its summary's file name adds ".json" (<= 255).
 _TPE_STARTUP_TRIALS = 4  # Trials sampled at random (the previous values among them) before TPE.
 _PRUNER_STARTUP_TRIALS = 3  # Complete trials before the pruner may stop one.
 _PRUNER_WARMUP_EPOCHS = 3  # Epochs every trial runs before it may be pruned.
@@ -110,9 +113,9 @@ def settings(
   """Checked study settings; the storage is opened once to check that it can be.
 
   Raises:
-    ValueError: an unknown or non-learning agent, an unknown robot or profile, fewer than one
-      trial, epochs outside 1 .. the profile's, an empty study name or a storage that cannot be
-      opened (one line).
+    ValueError: an unknown or non-learning agent, an unknown robot or profile, trials outside
+      1 .. ``MAX_TRIALS``, epochs outside 1 .. the profile's, a study name that is not a plain
+      name (``check_study_name``) or a storage that cannot be opened (one line).
   """
   if agents.learner(agent) is None:
     raise ValueError(
@@ -121,8 +124,7 @@ def settings(
     )
   robots.make(robot)
   chosen_profile = profiles.get(profile)
-  if isinstance(trials, bool) or not isinstance(trials, int) or trials < 1:
-    raise ValueError(f"trials must be a whole number of at least 1, got {trials!r}")
+  dataset.check_count("trials", trials, MAX_TRIALS)
   epochs = chosen_profile.max_epochs if epochs is None else epochs
   if (
     isinstance(epochs, bool)
@@ -134,13 +136,31 @@ def settings(
       f"profile's {chosen_profile.max_epochs}, got {epochs!r}"
     )
   name = study_name if study_name is not None else f"{agent}-{robot}-{chosen_profile.name}"
-  if not name.strip():
-    raise ValueError("the study name must not be empty")
+  check_study_name(name)
   if storage_url is None:
     storage.softbench_home().mkdir(parents=True, exist_ok=True)
     storage_url = default_storage()
   _open_storage(storage_url)
   return TuneSettings(agent, robot, trials, chosen_profile, storage_url, name, epochs)
+
+
+def check_study_name(name: str) -> None:
+  """Refuses a study name that is not a plain file name: its summary is ``NAME.json`` in the data
+  home's ``SUMMARY_FOLDER``, and ``../../../tmp/x`` wrote outside the data home.
+
+  Raises:
+    ValueError: an empty name, one with a path separator or a control character, ``.`` or
+      ``..``, or longer than ``MAX_STUDY_NAME_BYTES`` in UTF-8 (one line).
+  """
+  separators = {os.sep, os.altsep or os.sep}
+  if not name.strip():
+    raise ValueError("the study name must not be empty")
+  if name in (".", "..") or any(character in separators for character in name):
+    raise ValueError(f"the study name {name!r} must be a plain name, without '/' or '..'")
+  if not name.isprintable():
+    raise ValueError(f"the study name {name!r} must hold no control characters")
+  if len(name.encode()) > MAX_STUDY_NAME_BYTES:
+    raise ValueError(f"the study name must be at most {MAX_STUDY_NAME_BYTES} bytes long")
 
 
 def learner(agent: str) -> agents.Learner:
@@ -304,12 +324,14 @@ def tune(
 ) -> dict:
   """``softbench tune``: ``run``s the study (then ``confirm``s it if ``confirm_budget``), prints
   its report, writes its summary (to ``summary_file``, else ``summary_path``) and, if
-  ``adopt_best``, ``adopt``s its best values; returns the summary."""
+  ``adopt_best``, ``adopt``s its best values; returns the summary. The summary's path is checked
+  before the study runs (``storage.check_writable``: a folder there is refused at once, not once
+  the trials are spent)."""
+  path = storage.check_writable(summary_file or summary_path(settings), "the study summary")
   study_summary = run(settings)
   if confirm_budget:
     study_summary = confirm(settings, study_summary)
   print(report.summary_text(study_summary))
-  path = pathlib.Path(summary_file) if summary_file else summary_path(settings)
   write_summary(study_summary, path)
   print(f"study summary: {path}")
   if adopt_best:

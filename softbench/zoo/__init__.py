@@ -16,11 +16,12 @@ checked, with one line on stderr; a damaged or tampered file is refused with one
 model is trained instead. Everything else (checking the configuration, the weights' own hash) is
 the cache's usual loading.
 
-The zoo is ``$SOFTBENCH_ZOO`` if set (``none`` turns it off), else the ``zoo/`` folder of the
-source checkout softbench runs from (``chosen_folder``: the one a ``softbench zoo`` command works
-on). Which records each file stands behind, and re-scoring them from the zoo alone, belong to the
-leaderboard (``leaderboard.zoo_catalogue``, ``leaderboard.zoo_verification``); what
-``softbench zoo list`` and ``zoo add`` print, to ``zoo.listing``.
+The zoo is ``$SOFTBENCH_ZOO`` if set (``none`` turns it off; anything else but a folder is
+refused), else the ``zoo/`` folder of the source checkout softbench runs from (``chosen_folder``:
+the one a ``softbench zoo`` command works on). Which records each file stands behind, and
+re-scoring them from the zoo alone, belong to the leaderboard (``leaderboard.zoo_catalogue``,
+``leaderboard.zoo_verification``); what ``softbench zoo list`` and ``zoo add`` print, to
+``zoo.listing``.
 """
 
 import dataclasses
@@ -78,9 +79,26 @@ def location() -> pathlib.Path | None:
 
 
 def folder() -> pathlib.Path | None:
-  """The zoo in use: ``location()`` if it is a folder, else None."""
+  """The zoo in use: ``location()`` if it is a folder, else None (turned off, or no checkout's
+  ``zoo/``).
+
+  Raises:
+    ValueError: ``$SOFTBENCH_ZOO`` names something other than a folder (one line naming the
+      variable: a zoo named and not used would train what it holds, silently).
+  """
   path = location()
-  return path if path is not None and path.is_dir() else None
+  if path is None or path.is_dir():
+    return path
+  if os.environ.get(VARIABLE):
+    try:
+      found = f"is {storage.file_kind(os.stat(path).st_mode)}"
+    except OSError:
+      found = "does not exist"
+    raise ValueError(
+      f"${VARIABLE}={str(path)!r} {found}, not a zoo folder; name one, or set it to {OFF} to "
+      "turn the zoo off"
+    )
+  return None
 
 
 def chosen_folder(given: str | os.PathLike | None = None, create: bool = False) -> pathlib.Path:
