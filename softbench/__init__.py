@@ -52,7 +52,12 @@ def load_triton_before_egl() -> bool:
       stacklevel=3,
     )
     return False
-  importlib.import_module(TRITON_LIBRARY)
+  try:
+    importlib.import_module(TRITON_LIBRARY)
+  except Exception as error:  # A broken triton must not break softbench; torch may fail later.
+    message = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
+    warnings.warn(f"triton is installed but cannot be loaded: {message}", RuntimeWarning, 2)
+    return False
   return True
 
 
