@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from softbench import agents
+from softbench import cli
 from softbench import evaluation
 from softbench import profiles
 from softbench import robots
@@ -149,7 +150,9 @@ def installed_plugin(tmp_path) -> dict:
   return {**os.environ, "PYTHONPATH": str(tmp_path), "SOFTBENCH_HOME": str(tmp_path / "home")}
 
 
-def test_an_installed_packages_agent_runs_from_the_command_line(installed_plugin, tmp_path):
+def test_an_installed_packages_agent_runs_from_the_command_line(
+  installed_plugin, tmp_path, monkeypatch, restored_registries, capsys
+):
   # In seed workers too (--workers 2): they register the installed agents as the parent does.
   softbench = [sys.executable, "-c", "import sys; from softbench import cli; sys.exit(cli.main())"]
   run = ["run", "--task", "circle", "--agent", "hold-still", "--robot", ROBOT, "--profile", "tiny"]
@@ -165,13 +168,16 @@ def test_an_installed_packages_agent_runs_from_the_command_line(installed_plugin
     "'hold_still_plugin:NOT_AN_ENTRY' left out: it names a int, not a softbench.agents.AgentEntry"
   )
   assert result.stderr.splitlines().count(warning) == 1, result.stderr
-  listed = subprocess.run(
-    softbench + ["agents"], env=installed_plugin, capture_output=True, text=True, timeout=120
-  )
-  assert "hold-still" in listed.stdout and "broken" not in listed.stdout
-  refused = subprocess.run(
-    softbench + [*run[:4], "broken", *run[5:]], env=installed_plugin, capture_output=True, text=True
-  )
-  assert refused.returncode == 2 and refused.stderr.splitlines()[-1] == (
-    "softbench: error: " + warning.removeprefix("softbench: warning: ")
-  )
+  # In this process: the listing has the good one, and the broken one is refused with why.
+  monkeypatch.syspath_prepend(str(tmp_path))
+  monkeypatch.setattr(agents, "LEFT_OUT", {})
+  monkeypatch.setattr(agents, "_INSTALLED", {})
+  assert agents.register_installed() == ["hold-still"]
+  with pytest.warns(RuntimeWarning, match="agent 'broken' of entry point"):
+    assert cli.main(["agents"]) == 0
+  listed = capsys.readouterr().out
+  assert "hold-still" in listed and "broken" not in listed
+  with pytest.warns(RuntimeWarning, match="agent 'broken' of entry point"):
+    assert cli.main([*run[:4], "broken", *run[5:]]) == cli.EXIT_USAGE
+  refusal = capsys.readouterr().err.splitlines()
+  assert refusal[-1] == "softbench: error: " + warning.removeprefix("softbench: warning: ")
