@@ -120,8 +120,10 @@ def test_info_and_score_policy_score_as_the_leaderboard_does(robot, task):
 
 
 def test_score_policy_refuses_a_bad_seed_count():
-  with pytest.raises(ValueError, match="seeds must be an integer from 1 to 1000"):
+  with pytest.raises(ValueError, match="seeds must be a positive integer, got 0"):
     scoring.score_policy(lambda observation: None, "tendon-1", "circle", seeds=0)
+  with pytest.raises(ValueError, match="seeds must be at most 1,000, got 1001"):
+    scoring.score_policy(lambda observation: None, "tendon-1", "circle", seeds=1001)
 
 
 @pytest.mark.parametrize("robot,task", FAMILY_PAIRS)

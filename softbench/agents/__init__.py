@@ -21,6 +21,7 @@ from typing import Callable
 
 from softbench import profiles
 from softbench import robots
+from softbench import storage
 from softbench.agents.base import Agent
 from softbench.agents.base import EpisodeInfo
 from softbench.agents.learners import OPTIMISATION
@@ -131,9 +132,8 @@ def register_installed() -> list[str]:
         raise TypeError(f"it names a {type(entry).__name__}, not a softbench.agents.AgentEntry")
       register(point.name, entry)
     except Exception as error:  # A broken package must not break softbench: it is named.
-      reason = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
       LEFT_OUT[point.name] = (
-        f"agent {point.name!r} of entry point {point.value!r} left out: {reason}"
+        f"agent {point.name!r} of entry point {point.value!r} left out: {storage.first_line(error)}"
       )
       continue
     _INSTALLED[point.name] = entry

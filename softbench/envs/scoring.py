@@ -19,7 +19,9 @@ import dataclasses
 import numpy as np
 
 from softbench import metrics
+from softbench import profiles
 from softbench import robots
+from softbench.data import dataset
 from softbench.envs import environment
 
 DEFAULT_SEEDS = 5  # As the default and paper profiles score.
@@ -65,8 +67,7 @@ def score_policy(
   Raises:
     ValueError: a bad robot, task, option or seed count (one line).
   """
-  if not (isinstance(seeds, int) and 1 <= seeds <= 1000):
-    raise ValueError(f"seeds must be an integer from 1 to 1000, got {seeds!r}")
+  dataset.check_count("seeds", seeds, profiles.MAX_SEEDS)
   env = environment.SoftArmEnv(robot, task, **options)
   per_seed = []
   for seed in range(seeds):
