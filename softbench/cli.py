@@ -109,8 +109,8 @@ def _tune(args: argparse.Namespace) -> None:
 
 
 def _run_protocol(args: argparse.Namespace) -> None:
-  from softbench import continual
-  from softbench import saving
+  from softbench.runners import continual
+  from softbench.runners import saving
 
   settings = continual.settings(
     args.protocol,
@@ -135,17 +135,17 @@ def _run_protocol(args: argparse.Namespace) -> None:
 
 def _video_request(args: argparse.Namespace, path: str):
   """A ``run.VideoRequest`` of the options the video flags give, to ``path``; both checked."""
-  from softbench import run as run_module
   from softbench.rendering import options as video_options
+  from softbench.runners import run as run_module
 
   options = video_options.from_text(**{name: getattr(args, name) for name in _VIDEO_OPTIONS})
   return run_module.VideoRequest(video_options.check_video_path(path), options)
 
 
 def _run(args: argparse.Namespace) -> None:
-  from softbench import run as run_module
-  from softbench import saving
   from softbench.data import dataset
+  from softbench.runners import run as run_module
+  from softbench.runners import saving
 
   video_flags = _flags_given(args, _VIDEO_OPTIONS)
   if args.video is None and video_flags:
@@ -190,9 +190,9 @@ def _run(args: argparse.Namespace) -> None:
 
 
 def _render(args: argparse.Namespace) -> None:
-  from softbench import run as run_module
   from softbench.data import seeding
   from softbench.rendering import options as video_options
+  from softbench.runners import run as run_module
 
   request = _video_request(args, args.out)
   seed = video_options.parse_number("seed", args.seed, int)
@@ -302,8 +302,8 @@ def _check_record_arguments(args: argparse.Namespace) -> None:
 
 
 def _sweep(args: argparse.Namespace) -> None:
-  from softbench import continual
   from softbench import sweep
+  from softbench.runners import continual
 
   _check_physics(args)
   if args.protocol is None and args.families is not None:
@@ -359,8 +359,8 @@ def _leaderboard(args: argparse.Namespace) -> None:
 
 
 def _retrain(args: argparse.Namespace) -> None:
-  from softbench import retrain as retrain_module
-  from softbench import saving
+  from softbench.runners import retrain as retrain_module
+  from softbench.runners import saving
 
   settings = retrain_module.settings(
     args.agent, args.robot, tuple(args.fault), args.profile, args.task, args.seeds, args.baseline
@@ -379,7 +379,7 @@ def _zoo_list(args: argparse.Namespace) -> None:
 
 def _zoo_add(args: argparse.Namespace) -> None:
   from softbench import zoo
-  from softbench.leaderboard import zoo_catalogue
+  from softbench.runners import zoo_catalogue
   from softbench.zoo import listing as zoo_listing
 
   chosen = zoo_catalogue.requested_setting(
@@ -394,7 +394,7 @@ def _zoo_add(args: argparse.Namespace) -> None:
 
 def _zoo_remove(args: argparse.Namespace) -> None:
   from softbench import zoo
-  from softbench.leaderboard import zoo_catalogue
+  from softbench.runners import zoo_catalogue
   from softbench.zoo import listing as zoo_listing
 
   chosen = zoo_catalogue.requested_setting(
@@ -406,7 +406,7 @@ def _zoo_remove(args: argparse.Namespace) -> None:
 
 def _zoo_verify(args: argparse.Namespace) -> None:
   from softbench import zoo
-  from softbench.leaderboard import zoo_verification
+  from softbench.runners import zoo_verification
 
   zoo_verification.verify_zoo(
     pathlib.Path(args.results),
@@ -534,11 +534,11 @@ def _tune_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run_arguments(parser: argparse.ArgumentParser) -> None:
-  from softbench import adaptive
   from softbench import agents
   from softbench import robots
   from softbench import suite
   from softbench.records import exp1s as exp1s_records
+  from softbench.runners import adaptive
 
   parser.add_argument("--task", help=f"one of {', '.join(suite.TASKS)}")
   parser.add_argument(
@@ -718,7 +718,7 @@ def _render_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _retrain_arguments(parser: argparse.ArgumentParser) -> None:
-  from softbench import retrain as retrain_module
+  from softbench.runners import retrain as retrain_module
 
   parser.add_argument(
     "--agent",
@@ -948,15 +948,17 @@ _ZOO_COMMANDS = ("run", "render", "retrain", "sweep")  # They take trained weigh
 # (EXIT_USAGE, as ValueError does), and a run that failed (EXIT_FAILURE).
 _USAGE_ERRORS = ("softbench.rendering.video:RenderingUnavailable",)
 _RUN_FAILURES = (
-  "softbench.parallel_seeds:WorkerDied",
+  "softbench.runners.parallel_seeds:WorkerDied",
   "softbench.rendering.video:RenderingFailed",
-  "softbench.continual:ForgettingDetected",
-  "softbench.leaderboard.zoo_verification:ZooMismatch",
+  "softbench.runners.continual:ForgettingDetected",
+  "softbench.runners.zoo_verification:ZooMismatch",
   "softbench.sweep:SweepFailed",
 )
 
 
-_RUN_COMPLETE = ("softbench.saving:RunComplete",)  # An interrupt once the record was written.
+_RUN_COMPLETE = (
+  "softbench.runners.saving:RunComplete",
+)  # An interrupt once the record was written.
 
 
 def _imported_classes(names: tuple[str, ...]) -> tuple[type[BaseException], ...]:

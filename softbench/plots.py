@@ -232,7 +232,7 @@ def save_run_plots(
   record_path: str | pathlib.Path, record: dict, episodes: Sequence[episodes.Episode]
 ) -> tuple[pathlib.Path, pathlib.Path]:
   """Saves the first episode's (seed 0's) tip paths and every episode's errors over time next to
-  the result record ``record`` (``softbench.run``): ``<record stem>-paths.png`` and
+  the result record ``record`` (``softbench.runners.run``): ``<record stem>-paths.png`` and
   ``<record stem>-error.png``."""
   robot = robots.make(record["robot"])
   title = f"{record['agent']} on {record['task']} ({record['robot']}), {record['profile']} profile"

@@ -14,14 +14,14 @@ import worker_hooks
 
 from smpl import snapshots
 from smpl import training
-from softbench import continual
 from softbench import data
 from softbench import leaderboard
 from softbench import profiles
-from softbench import protocols
 from softbench import zoo
 from softbench.agents import learned
 from softbench.data import dataset as data_files
+from softbench.learning import protocols
+from softbench.runners import continual
 
 
 @pytest.fixture(autouse=True)

@@ -3,11 +3,11 @@ per configuration, normalised tip errors that follow from them, triangular forge
 
 import numpy as np
 
-from softbench import continual
 from softbench import metrics
 from softbench import profiles
 from softbench import robots
 from softbench.robots import versions
+from softbench.runners import continual
 
 ROBOTS = tuple(f"tendon-{n}" for n in range(1, 6))
 DATE = "2026-01-02T03:04:05+00:00"

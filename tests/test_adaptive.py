@@ -8,11 +8,11 @@ import pytest
 
 from softbench import agents
 from softbench import cli
-from softbench import evaluation
 from softbench import suite
-from softbench.adaptive import experiment
-from softbench.adaptive import procedure
 from softbench.agents import learned
+from softbench.runners import evaluation
+from softbench.runners.adaptive import experiment
+from softbench.runners.adaptive import procedure
 
 ROBOT = "pneumatic-433"  # Three modules of 4, 3 and 3 action entries.
 MODULE_ENTRIES = {1: range(0, 4), 2: range(4, 7), 3: range(7, 10)}

@@ -15,18 +15,18 @@ import torch
 from softbench import agents
 from softbench import cli
 from softbench import data
-from softbench import evaluation
-from softbench import parallel_seeds
 from softbench import profiles
-from softbench import protocols
 from softbench import records
 from softbench import robots
-from softbench import run
 from softbench import storage
 from softbench import suite
 from softbench import terminal
-from softbench.agents import forward_models
 from softbench.agents import learned
+from softbench.learning import forward_models
+from softbench.learning import protocols
+from softbench.runners import evaluation
+from softbench.runners import parallel_seeds
+from softbench.runners import run
 
 # Every task of the suite on tendon-2, and one on the pneumatic arm.
 TASKS = tuple(pair for pair in suite.ALL_TASKS if pair[0] == "tendon-2") + (

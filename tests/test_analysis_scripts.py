@@ -15,11 +15,11 @@ from softbench import cli
 from softbench import data
 from softbench import records
 from softbench import robots
-from softbench import run
 from softbench.agents import hyperparameters
 from softbench.agents import learned
 from softbench.agents import learners
 from softbench.robots import versions
+from softbench.runners import run
 
 ANALYSIS = pathlib.Path(__file__).parent.parent / "docs" / "analysis"
 

@@ -13,17 +13,17 @@ import pytest
 
 from softbench import agents
 from softbench import data
-from softbench import episode_snapshots
-from softbench import evaluation
 from softbench import profiles
-from softbench import run
 from softbench import storage
 from softbench import suite
-from softbench.agents import forward_models
 from softbench.agents import learned
 from softbench.data import babbling
 from softbench.data import chunks
 from softbench.data import dataset
+from softbench.episodes import snapshots as episode_snapshots
+from softbench.learning import forward_models
+from softbench.runners import evaluation
+from softbench.runners import run
 from softbench.suite import references
 
 ROBOT = "tendon-1"

@@ -7,13 +7,13 @@ import pytest
 import torch
 
 from softbench import cli
-from softbench import continual
 from softbench import data
-from softbench import episode_snapshots
 from softbench import profiles
 from softbench import records
 from softbench import robots
 from softbench.agents import learned
+from softbench.episodes import snapshots as episode_snapshots
+from softbench.runners import continual
 
 
 def test_exp1s_end_to_end(two_stages, tmp_path, capsys):

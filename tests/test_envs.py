@@ -17,7 +17,6 @@ import numpy as np
 import pytest
 
 from softbench import agents
-from softbench import evaluation
 from softbench import metrics
 from softbench import robots
 from softbench import suite
@@ -26,6 +25,7 @@ from softbench.envs import environment
 from softbench.envs import scoring
 from softbench.robots import faults
 from softbench.robots import versions
+from softbench.runners import evaluation
 from softbench.suite import references
 
 ID_VERSION = f"v{softbench.envs.VERSION}"  # The installed physics version, which ids end in.

@@ -17,13 +17,13 @@ import numpy as np
 import pytest
 
 from softbench import cli
-from softbench import continual
 from softbench import leaderboard
 from softbench import records
-from softbench import run
 from softbench.leaderboard import exp1s_board
 from softbench.leaderboard import html_page
 from softbench.records import exp1s as exp1s_records
+from softbench.runners import continual
+from softbench.runners import run
 
 
 def write_raw(record: dict, path: pathlib.Path, reseal: bool = True) -> pathlib.Path:

@@ -13,13 +13,13 @@ from softbench import agents
 from softbench import cli
 from softbench import data
 from softbench import profiles
-from softbench import retrain
 from softbench import robots
 from softbench import storage
 from softbench import suite
 from softbench.agents import adaptation
 from softbench.agents import learned
 from softbench.robots import faults
+from softbench.runners import retrain
 
 STEPS_BEFORE = 60  # Physics steps under a random action, so that forces are read in a bent state.
 

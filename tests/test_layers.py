@@ -101,7 +101,7 @@ def find_cycle(graph: dict[str, dict[str, list[str]]]) -> list[str] | None:
 
 def test_softbench_units_import_without_a_cycle():
   graph = import_graph()
-  assert {"robots", "suite", "run", "leaderboard", "records"} <= set(graph)
+  assert {"robots", "suite", "runners", "leaderboard", "records"} <= set(graph)
   cycle = find_cycle(graph)
   assert cycle is None, (
     " -> ".join(f"{unit} ({graph[unit][other][0]})" for unit, other in zip(cycle, cycle[1:]))
@@ -193,8 +193,10 @@ def _loaded_with(module: str) -> set[str]:
 
 def test_seed_workers_and_sweep_tasks_load_no_plotting():
   # Each seed worker and Ray task imports these in a fresh process; matplotlib took 0.7 s of it.
-  for module in ("softbench.run", "softbench.continual", "softbench.sweep.tasks"):
+  for module in ("softbench.runners.run", "softbench.runners.continual", "softbench.sweep.tasks"):
     loaded = _loaded_with(module)
-    assert {"softbench.run", "softbench.agents", "torch"} & loaded, module  # The walk works.
+    assert {"softbench.runners.run", "softbench.agents", "torch"} & loaded, (
+      module
+    )  # The walk works.
     plotting = sorted(name for name in loaded if name.split(".")[0] == "matplotlib")
     assert not plotting, f"{module} loads {plotting}"

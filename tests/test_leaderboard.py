@@ -22,7 +22,6 @@ from softbench import cli
 from softbench import leaderboard
 from softbench import metrics
 from softbench import records
-from softbench import run
 from softbench.leaderboard import aggregate
 from softbench.leaderboard import csv_table
 from softbench.leaderboard import filters
@@ -31,6 +30,7 @@ from softbench.leaderboard import overview
 from softbench.leaderboard import ranking
 from softbench.leaderboard import verified
 from softbench.leaderboard import winners
+from softbench.runners import run
 
 
 @pytest.fixture(scope="module")

@@ -15,13 +15,13 @@ from softbench import agents
 from softbench import cli
 from softbench import data
 from softbench import robots
-from softbench import run
 from softbench import storage
 from softbench import suite
 from softbench.agents import hyperparameters
 from softbench.robots import export
 from softbench.robots import versions
 from softbench.robots.physics import SoftArmPhysics
+from softbench.runners import run
 
 MODELS = pathlib.Path(__file__).resolve().parents[1] / "models"
 

@@ -1,5 +1,5 @@
-"""Seeds in worker processes (``softbench.run``): results in order, errors raised, a dead worker
-reported instead of a hang, Ctrl-C or kill stopping every worker."""
+"""Seeds in worker processes (``softbench.runners.run``): results in order, errors raised, a dead
+worker reported instead of a hang, Ctrl-C or kill stopping every worker."""
 
 import multiprocessing
 import os
@@ -13,8 +13,8 @@ import process_tree
 import pytest
 import torch
 
-from softbench import parallel_seeds
 from softbench import progress
+from softbench.runners import parallel_seeds
 
 CHILD_DEADLINE_S = 60  # (s) A child program still running after this has hung.
 
@@ -77,7 +77,7 @@ def test_a_worker_error_is_raised():
 _DYING_PROGRAM = """
 import sys
 sys.path.insert(0, {tests!r})
-from softbench import parallel_seeds
+from softbench.runners import parallel_seeds
 from softbench import progress
 import test_parallel_seeds
 for dying in (test_parallel_seeds.die, test_parallel_seeds.crash):
@@ -108,7 +108,7 @@ import signal, sys, time
 # non-interactive shell, which leaves SIGINT ignored in every process it starts.
 signal.signal(signal.SIGINT, signal.default_int_handler)
 sys.path.insert(0, {tests!r})
-from softbench import parallel_seeds
+from softbench.runners import parallel_seeds
 from softbench import progress
 from softbench import terminal
 import test_parallel_seeds
@@ -147,7 +147,7 @@ def test_ctrl_c_or_kill_stops_every_worker(stop):
 _SEMAPHORE_PROGRAM = """
 import sys
 sys.path.insert(0, {tests!r})
-from softbench import parallel_seeds
+from softbench.runners import parallel_seeds
 from softbench import progress
 import test_parallel_seeds
 print(parallel_seeds.in_processes(test_parallel_seeds.doubled_holding_a_semaphore,
@@ -180,7 +180,7 @@ def test_finished_workers_exit_cleanly():
 _KILLED_PROGRAM = """
 import sys
 sys.path.insert(0, {tests!r})
-from softbench import parallel_seeds
+from softbench.runners import parallel_seeds
 import test_parallel_seeds
 parallel_seeds.in_processes(test_parallel_seeds.sleep_long, [(0,), (1,)], "sleepers", workers=2)
 """

@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from softbench import evaluation
 from softbench import robots
 from softbench import suite
 from softbench.agents import zero
 from softbench.robots import recorder
+from softbench.runners import evaluation
 from softbench.suite import tracking
 from softbench.suite import trajectories
 from softbench.suite.trajectories import Given

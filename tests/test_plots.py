@@ -10,10 +10,10 @@ import pytest
 
 from softbench import agents
 from softbench import cli
-from softbench import evaluation
 from softbench import plots
 from softbench import records
 from softbench import suite
+from softbench.runners import evaluation
 
 
 @pytest.fixture(autouse=True)

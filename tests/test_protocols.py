@@ -7,7 +7,7 @@ import pytest
 import torch
 
 from smpl import training
-from softbench import protocols
+from softbench.learning import protocols
 
 SAMPLES = 200  # Enough for a 15-step window in every split (validation: 20 samples).
 TINY_FORWARD = training.ForwardTrainingConfig(max_epochs=2, patience=2)

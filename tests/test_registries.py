@@ -14,13 +14,13 @@ import pytest
 
 from softbench import agents
 from softbench import cli
-from softbench import evaluation
 from softbench import profiles
 from softbench import robots
 from softbench import suite
 from softbench.agents import hyperparameters
 from softbench.agents import learned
 import softbench.envs
+from softbench.runners import evaluation
 
 ROBOT = "tendon-1"
 

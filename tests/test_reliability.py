@@ -17,18 +17,18 @@ import process_tree
 import pytest
 
 from softbench import cli
-from softbench import continual
-from softbench import episode_snapshots
 from softbench import plots
 from softbench import records
-from softbench import retrain
 from softbench import robots
-from softbench import run
-from softbench import saving
 from softbench import storage
 from softbench import terminal
 from softbench import tuning
 from softbench import zoo
+from softbench.episodes import snapshots as episode_snapshots
+from softbench.runners import continual
+from softbench.runners import retrain
+from softbench.runners import run
+from softbench.runners import saving
 from softbench.suite import references
 from softbench.sweep import grid as sweep_grid
 from softbench.sweep import guard

@@ -10,7 +10,6 @@ import pytest
 import softbench
 from softbench import agents
 from softbench import cli
-from softbench import evaluation
 from softbench import robots
 from softbench import suite
 from softbench.rendering import markers
@@ -18,6 +17,7 @@ from softbench.rendering import options
 from softbench.rendering import replay
 from softbench.rendering import scene
 from softbench.rendering import video
+from softbench.runners import evaluation
 
 SMALL = options.VideoOptions(width=64, height=48)
 

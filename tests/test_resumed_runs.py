@@ -8,14 +8,14 @@ import numpy as np
 import pytest
 
 from softbench import cli
-from softbench import episode_snapshots
 from softbench import episodes
-from softbench import evaluation
 from softbench import records
 from softbench import robots
-from softbench import run
 from softbench import suite
 from softbench.agents import reference
+from softbench.episodes import snapshots as episode_snapshots
+from softbench.runners import evaluation
+from softbench.runners import run
 
 SEEDS = 3
 

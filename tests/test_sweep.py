@@ -22,15 +22,15 @@ from ray import cluster_utils
 import worker_hooks
 
 from softbench import cli
-from softbench import continual
 from softbench import profiles
-from softbench import protocols
 from softbench import records
-from softbench import run
 from softbench import storage
 from softbench import sweep
 from softbench import zoo
 from softbench.agents import learned
+from softbench.learning import protocols
+from softbench.runners import continual
+from softbench.runners import run
 from softbench.sweep import display
 from softbench.sweep import execution
 from softbench.sweep import grid as sweep_grid

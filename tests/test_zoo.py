@@ -11,18 +11,18 @@ import pytest
 from smpl import training
 from softbench import agents
 from softbench import cli
-from softbench import evaluation
 from softbench import leaderboard
 from softbench import profiles
-from softbench import protocols
 from softbench import records
 from softbench import suite
 from softbench import zoo
 from softbench.agents import learned
 from softbench.data import dataset as data_files
 from softbench.leaderboard import verified
-from softbench.leaderboard import zoo_catalogue as catalogue
+from softbench.learning import protocols
 from softbench.robots import versions
+from softbench.runners import evaluation
+from softbench.runners import zoo_catalogue as catalogue
 
 LEARNED_AGENTS = agents.babbling_learners()  # The agents whose weights the zoo keeps.
 CHECKOUT = pathlib.Path(__file__).resolve().parents[1]

@@ -4,9 +4,9 @@ failing."""
 
 import dataclasses
 
-from softbench import continual
-from softbench import protocols
-from softbench import run
+from softbench.learning import protocols
+from softbench.runners import continual
+from softbench.runners import run
 
 EXP1S_STAGES = ("tendon-1", "tendon-2")  # Exp1S on these arms (of whichever family), not 1 .. 5.
 BROKEN = "an evaluation broken on purpose"  # The error of ``break_zero_evaluations``.

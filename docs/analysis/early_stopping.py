@@ -20,9 +20,9 @@ from smpl import training
 from softbench import agents
 from softbench import profiles
 from softbench import robots
-from softbench import run
 from softbench.agents import hyperparameters
 from softbench.agents import learned
+from softbench.runners import run
 from softbench.tuning import study
 
 

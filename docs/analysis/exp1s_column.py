@@ -23,13 +23,13 @@ import torch
 from smpl import progressive
 from smpl import protocol as smpl_protocol
 from smpl import windows as smpl_windows
-from softbench import continual
 from softbench import data
-from softbench import evaluation
 from softbench import profiles
-from softbench import protocols
 from softbench import suite
 from softbench.agents import learned
+from softbench.learning import protocols
+from softbench.runners import continual
+from softbench.runners import evaluation
 
 
 def _setting(text: str) -> tuple[str, float]:

@@ -20,9 +20,9 @@ import torch
 
 from softbench import data
 from softbench import profiles
-from softbench import protocols
 from softbench import robots
 from softbench.agents import learned
+from softbench.learning import protocols
 
 
 def main() -> None:

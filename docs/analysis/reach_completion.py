@@ -19,9 +19,9 @@ import time
 import numpy as np
 
 from softbench import agents
-from softbench import evaluation
 from softbench import suite
 from softbench.agents import learned
+from softbench.runners import evaluation
 
 QUARTILES = (25, 50, 75)  # (%) Percentiles reported over targets.
 

@@ -21,10 +21,10 @@ import numpy as np
 
 from softbench import records
 from softbench import zoo
-from softbench.leaderboard import zoo_verification
 from softbench.records import fields as record_fields
 from softbench.robots import base
 from softbench.robots import versions
+from softbench.runners import zoo_verification
 
 CHECKOUT = pathlib.Path(__file__).resolve().parents[2]
 METRIC = "position_mm"

@@ -25,9 +25,9 @@ import time
 from softbench import data
 from softbench import profiles
 from softbench import robots
-from softbench import run
 from softbench.agents import hyperparameters
 from softbench.agents import learned
+from softbench.runners import run
 
 VIEWS = {
   "own": data.View.module,  # Module k's forward model reads modules 1..k's actuation.

@@ -31,10 +31,10 @@ from softbench import leaderboard
 from softbench import profiles
 from softbench import records
 from softbench import robots
-from softbench import run
 from softbench.agents import hyperparameters
 from softbench.agents import learned
 from softbench.agents import learners
+from softbench.runners import run
 
 
 def check_preceding_is_proximal(windows: list) -> None:

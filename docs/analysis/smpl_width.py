@@ -20,10 +20,10 @@ from unittest import mock
 from smpl import progressive
 from softbench import profiles
 from softbench import robots
-from softbench import run
 from softbench.agents import hyperparameters
 from softbench.agents import learned
 from softbench.agents import learners
+from softbench.runners import run
 
 
 def _columns(text: str) -> tuple[int, int]:

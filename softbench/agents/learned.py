@@ -27,13 +27,13 @@ is given; ``share`` gives every active module the scored module's remaining posi
 its pose now shifted by that error, and asks every inactive one for nothing (its pose now). A
 target that gives every module's whole pose is used as it is.
 
-``active_modules`` (1-based; None: every module) switches modules off: their action entries are
-zero (passive: no cable tension, zero pressure). The model still computes every output, so an
-SMPL column of an inactive module keeps running as an observer of its module, on its real pose,
-target, error and the zero action it actually received; the active columns read it through the
-lateral connections as they were trained to. A centralised baseline is masked the same way,
-which keeps comparisons fair (``softbench.adaptive``). With every module active the actions are
-those of the unmasked agent, bit for bit.
+``active_modules`` (1-based; None: every module) switches modules off: their action entries are zero
+(passive: no cable tension, zero pressure). The model still computes every output, so an SMPL column
+of an inactive module keeps running as an observer of its module, on its real pose, target, error
+and the zero action it actually received; the active columns read it through the lateral connections
+as they were trained to. A centralised baseline is masked the same way, which keeps comparisons fair
+(``softbench.runners.adaptive``). With every module active the actions are those of the unmasked
+agent, bit for bit.
 """
 
 import dataclasses
@@ -57,9 +57,9 @@ from softbench import storage
 from softbench import zoo
 from softbench.agents import base
 from softbench.agents import completion
-from softbench.agents import forward_models
 from softbench.agents import hyperparameters
 from softbench.agents import learners
+from softbench.learning import forward_models
 from softbench.records.fields import ERROR_SOURCES
 from softbench.records.fields import HELPER_TARGETS
 from softbench.robots import base as robot_base

@@ -269,7 +269,8 @@ def _rank_one(loaded: list[tuple[pathlib.Path, dict]], physics: str) -> Leaderbo
   """The leaderboard of checked records of one physics version."""
   by_group: dict[tuple[str, str, str], list[Entry]] = {}
   for path, record in loaded:
-    # Adaptive activation records hold per-target results, no per-seed ones (softbench.adaptive).
+    # Adaptive activation records hold per-target results, no per-seed ones
+    # (softbench.runners.adaptive).
     if record["format"] == records.FORMAT and record["per_seed"]:
       by_group.setdefault(_group_key(record), []).append(Entry.of(path, record))
   groups = []

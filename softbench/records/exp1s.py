@@ -6,7 +6,8 @@ A record (format ``softbench-exp1s-result``, version 2) holds provenance, settin
 effector's position (mm), orientation (deg) and normalised tip (%) errors averaged over the
 episode; ``forgetting_model_pose_mse`` and ``forgetting_tip_percent``, stages x configurations,
 ``null`` exactly above the diagonal (a configuration not yet learned). Version 1 (before the
-integrity hash) is refused. The layout is ``softbench.continual``'s, which writes these records.
+integrity hash) is refused. The layout is ``softbench.runners.continual``'s, which writes these
+records.
 """
 
 import math

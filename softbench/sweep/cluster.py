@@ -14,9 +14,9 @@ import ray
 from ray.util import scheduling_strategies
 
 from smpl.files import first_line
-from softbench import episode_snapshots
 from softbench import storage
 from softbench import zoo
+from softbench.episodes import snapshots as episode_snapshots
 from softbench.sweep import guard
 from softbench.sweep import tasks
 

@@ -25,11 +25,11 @@ import time
 import ray
 
 from smpl.files import first_line
-from softbench import continual
-from softbench import episode_snapshots
-from softbench import run as run_module
-from softbench import saving
+from softbench.episodes import snapshots as episode_snapshots
 from softbench.records import provenance
+from softbench.runners import continual
+from softbench.runners import run as run_module
+from softbench.runners import saving
 from softbench.sweep import cluster
 from softbench.sweep import display
 from softbench.sweep import grid

@@ -23,20 +23,20 @@ import itertools
 import pathlib
 
 from softbench import agents
-from softbench import continual
 from softbench import episodes
 from softbench import profiles
 from softbench import records
 from softbench import robots
-from softbench import run as run_module
 from softbench import storage
 from softbench import zoo
-from softbench.agents import forward_models
 from softbench.agents import learned
 from softbench.agents import learners
 from softbench.data import dataset as babbling_dataset
+from softbench.learning import forward_models
 from softbench.records import fields as record_fields
 from softbench.robots import versions
+from softbench.runners import continual
+from softbench.runners import run as run_module
 
 KINDS = ("dataset", "forward", "agent", "network")  # What a build makes (network: Exp1S's).
 Setting = run_module.RunSettings | continual.RunSettings  # A task's run, or an Exp1S run.

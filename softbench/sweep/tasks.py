@@ -15,15 +15,15 @@ import torch
 
 from smpl import training
 from softbench import agents
-from softbench import continual
 from softbench import data
-from softbench import episode_snapshots
 from softbench import progress
 from softbench import robots
-from softbench import run as run_module
 from softbench import terminal
 from softbench.agents import learned
 from softbench.agents import learners
+from softbench.episodes import snapshots as episode_snapshots
+from softbench.runners import continual
+from softbench.runners import run as run_module
 from softbench.sweep import relay
 from softbench.sweep import shipping
 

@@ -6,8 +6,8 @@ import collections
 
 import numpy as np
 
-from softbench.adaptive import experiment
-from softbench.adaptive import procedure
+from softbench.runners.adaptive import experiment
+from softbench.runners.adaptive import procedure
 
 PLOTTED_TARGETS = 4  # Targets whose paths the record keeps (and the plot draws).
 _DECIMALS = 3  # Rounding of positions in the record (mm).

@@ -14,17 +14,17 @@ import tempfile
 import time
 
 from softbench import agents as agent_registry
-from softbench import continual
 from softbench import profiles
 from softbench import records
 from softbench import robots
-from softbench import run as run_module
 from softbench import storage
 from softbench import zoo
 from softbench.leaderboard import verified
 from softbench.records import fields as record_fields
 from softbench.records import provenance
 from softbench.robots import versions
+from softbench.runners import continual
+from softbench.runners import run as run_module
 from softbench.suite import references as suite_references
 
 

@@ -12,9 +12,9 @@ from dm_control.rl import control
 import numpy as np
 
 from softbench import agents
-from softbench import episode_snapshots
 from softbench import episodes
 from softbench import progress as progress_bars
+from softbench.episodes import snapshots as episode_snapshots
 
 KEEP_INTERVAL_S = 60.0  # (s) Least time between two keepings of an unfinished episode.
 

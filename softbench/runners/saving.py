@@ -1,13 +1,12 @@
 """The one save path of every runner's result.
 
-A runner (``softbench.run``, ``softbench.continual``, ``softbench.retrain``) returns a record from
-its ``execute`` and offers ``table(record)`` and ``record_path(record, results)``; ``save`` prints
-the table, writes the record (checked, sealed and atomic, never over another record:
+A runner (``run``, ``continual``, ``retrain`` of ``softbench.runners``) returns a record from its
+``execute`` and offers ``table(record)`` and ``record_path(record, results)``; ``save`` prints the
+table, writes the record (checked, sealed and atomic, never over another record:
 ``records.write_new``) under the results folder (by default the user's own,
 ``records.user_folder()``) and to an extra copy if asked, and says where and how to rank it. What
 only one runner does afterwards (its plots, a video, discarding the finished seeds it kept for
-resuming) follows, once the record is safe.
-"""
+resuming) follows, once the record is safe."""
 
 from collections.abc import Callable
 import os

@@ -1,6 +1,6 @@
 """What happened in one episode of a task: the targets shown, the poses reached and the actions.
 
-Written by ``softbench.evaluation.run_episode``; read by the records, plots, videos and the
+Written by ``softbench.runners.evaluation.run_episode``; read by the records, plots, videos and the
 episode snapshots, none of which need the agents that produced it.
 """
 

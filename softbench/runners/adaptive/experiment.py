@@ -31,13 +31,13 @@ import dataclasses
 import numpy as np
 
 from softbench import agents
-from softbench import evaluation
 from softbench import metrics
 from softbench import profiles
 from softbench import suite
-from softbench.adaptive import procedure
 from softbench.agents import learned
 from softbench.robots import base as robot_base
+from softbench.runners import evaluation
+from softbench.runners.adaptive import procedure
 from softbench.suite import reach
 
 AGENT_SEED = 0  # Every target is reached by the agent trained with this seed.

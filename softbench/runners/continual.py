@@ -29,14 +29,10 @@ from smpl import progressive
 from smpl import protocol as smpl_protocol
 from smpl import training
 from softbench import data
-from softbench import episode_snapshots
 from softbench import episodes
-from softbench import evaluation
 from softbench import metrics
-from softbench import parallel_seeds
 from softbench import profiles
 from softbench import progress as progress_bars
-from softbench import protocols
 from softbench import robots
 from softbench import storage
 from softbench import suite
@@ -44,6 +40,8 @@ from softbench import zoo
 from softbench.agents import hyperparameters
 from softbench.agents import learned
 from softbench.data import dataset
+from softbench.episodes import snapshots as episode_snapshots
+from softbench.learning import protocols
 from softbench.records import provenance
 from softbench.records.exp1s import DEFAULT_FAMILY
 from softbench.records.exp1s import FORGETTING_TASK
@@ -53,6 +51,8 @@ from softbench.records.exp1s import METRICS
 from softbench.records.exp1s import PROTOCOL
 from softbench.records.exp1s import TASKS
 from softbench.records.exp1s import VERSION as RECORD_VERSION
+from softbench.runners import evaluation
+from softbench.runners import parallel_seeds
 
 
 def protocol(family: str = DEFAULT_FAMILY) -> protocols.Protocol:

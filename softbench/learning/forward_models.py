@@ -1,15 +1,14 @@
 """Frozen forward models, trained once and shared by every agent and tuning trial that needs them.
 
 A forward model's weights depend on the robot, the view it predicts, the babbling dataset and its
-training config (the paper's, seeded by the agent's seed), not on the inverse model trained
-through it. So the agents that read the same view with the same seed and profile (the four
-baselines' whole-arm model) and every trial of a tuning study share one: trained as
-``softbench.protocols.prepare_column`` trains it, cached under ``$SOFTBENCH_HOME/forward`` by a
-hash of everything its weights depend on (``ForwardModelConfig``), or taken from the zoo
-(``softbench.zoo``), and loaded with the weights a fresh training gives, to the bit. An
-interrupted training resumes from its snapshots (``smpl.snapshots``, in the cache file's
-``.partial`` folder); a damaged cache file is reported and trained again
-(``storage.read_cached``).
+training config (the paper's, seeded by the agent's seed), not on the inverse model trained through
+it. So the agents that read the same view with the same seed and profile (the four baselines'
+whole-arm model) and every trial of a tuning study share one: trained as
+``softbench.learning.protocols.prepare_column`` trains it, cached under ``$SOFTBENCH_HOME/forward``
+by a hash of everything its weights depend on (``ForwardModelConfig``), or taken from the zoo
+(``softbench.zoo``), and loaded with the weights a fresh training gives, to the bit. An interrupted
+training resumes from its snapshots (``smpl.snapshots``, in the cache file's ``.partial`` folder); a
+damaged cache file is reported and trained again (``storage.read_cached``).
 """
 
 import dataclasses
@@ -21,9 +20,9 @@ from smpl import snapshots
 from smpl import training
 from softbench import data
 from softbench import progress as progress_bars
-from softbench import protocols
 from softbench import storage
 from softbench import zoo
+from softbench.learning import protocols
 from softbench.robots import base as robot_base
 
 FOLDER = "forward"  # Under the data home.

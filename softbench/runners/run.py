@@ -6,7 +6,7 @@ errors per module are averaged over its steps, and the table gives their mean an
 deviation over seeds. Every run writes a result record with full provenance.
 
 With ``adaptive`` (task ``reach``, a learned agent), one agent (seed 0) reaches ``targets``
-virtual targets with adaptive module activation instead (``softbench.adaptive``); the record
+virtual targets with adaptive module activation instead (``softbench.runners.adaptive``); the record
 then holds an ``adaptive`` section and no per-seed scores.
 
 With ``faults`` (``--fault MODULE:ACTUATOR:GAIN``, ``softbench.robots.faults``) the agent is
@@ -17,30 +17,30 @@ import dataclasses
 import pathlib
 import time
 
-from softbench import adaptive as adaptive_activation
 from softbench import agents
 from softbench import data
-from softbench import episode_snapshots
 from softbench import episodes
-from softbench import evaluation
 from softbench import metrics
-from softbench import parallel_seeds
 from softbench import profiles
 from softbench import records
 from softbench import robots
-from softbench import saving
 from softbench import suite
 from softbench import zoo
-from softbench.adaptive import experiment as adaptive_experiment
-from softbench.adaptive import report as adaptive_report
-from softbench.adaptive import runner as adaptive_runner
 from softbench.agents import learned
 from softbench.data import dataset
+from softbench.episodes import snapshots as episode_snapshots
 from softbench.records import provenance
 from softbench.rendering import options as video_options
 from softbench.rendering import replay
 from softbench.rendering import video
 from softbench.robots import faults as fault_model
+from softbench.runners import adaptive as adaptive_activation
+from softbench.runners import evaluation
+from softbench.runners import parallel_seeds
+from softbench.runners import saving
+from softbench.runners.adaptive import experiment as adaptive_experiment
+from softbench.runners.adaptive import report as adaptive_report
+from softbench.runners.adaptive import runner as adaptive_runner
 from softbench.suite import reach
 from softbench.suite import trajectories
 
@@ -238,7 +238,7 @@ def finish(
   then the video, which the record files then link."""
   # Plotting imports matplotlib (0.7 s), which no seed worker or Ray task needs: not at the top.
   from softbench import plots
-  from softbench.adaptive import plot as adaptive_plot
+  from softbench.runners.adaptive import plot as adaptive_plot
 
   episode_snapshots.discard(run)
   if run.adaptive:
@@ -411,7 +411,7 @@ def execute_episodes(
   a learned agent's checkpoints that the data home lacks are taken from the zoo where it holds
   them (``softbench.zoo``; the record then names them in a ``zoo`` section), and the babbling
   dataset is collected only if some seed still has to train;
-  none for an adaptive run (``softbench.adaptive`` draws its own figure). The finished seeds
+  none for an adaptive run (``softbench.runners.adaptive`` draws its own figure). The finished seeds
   kept for resuming are discarded at the end unless ``keep_seeds``: then the caller discards
   them (``episode_snapshots.discard``) once the record is safely written."""
   started = time.perf_counter()
@@ -508,7 +508,7 @@ def summary(record: dict, metric: str) -> tuple[list[metrics.Statistic], metrics
 
 def table(record: dict) -> str:
   """The printed table: rows per scored module and their mean, columns per metric (an adaptive
-  run: ``softbench.adaptive.report.table``)."""
+  run: ``softbench.runners.adaptive.report.table``)."""
   if "adaptive" in record:
     return adaptive_report.table(record)
   measured = [(name, label) for name, label in METRICS if name in record["per_seed"][0]]

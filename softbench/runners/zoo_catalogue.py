@@ -7,7 +7,6 @@ import dataclasses
 import pathlib
 
 from softbench import agents
-from softbench import continual
 from softbench import profiles
 from softbench import records
 from softbench import robots
@@ -17,6 +16,7 @@ from softbench.agents import learned
 from softbench.data import seeding
 from softbench.records import fields as record_fields
 from softbench.robots import versions
+from softbench.runners import continual
 
 
 @dataclasses.dataclass(frozen=True)

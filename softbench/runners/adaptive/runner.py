@@ -1,14 +1,14 @@
 """``softbench run --adaptive``: builds (trains or loads) the agent, reaches the virtual targets
 adaptively (``experiment``) and returns the record's ``adaptive`` section (``report``). Apart
-from the package so that ``softbench.adaptive``'s defaults import without torch."""
+from the package so that ``softbench.runners.adaptive``'s defaults import without torch."""
 
 from softbench import agents
 from softbench import profiles
 from softbench import progress as progress_bars
 from softbench import robots
-from softbench.adaptive import DEFAULT_TARGETS
-from softbench.adaptive import experiment
-from softbench.adaptive import report
+from softbench.runners.adaptive import DEFAULT_TARGETS
+from softbench.runners.adaptive import experiment
+from softbench.runners.adaptive import report
 from softbench.suite import reach
 
 

@@ -25,11 +25,11 @@ from softbench import data
 from softbench import metrics
 from softbench import profiles
 from softbench import robots
-from softbench import run as run_module
 from softbench.agents import adaptation
 from softbench.agents import learned
 from softbench.records import provenance
 from softbench.robots import faults as fault_model
+from softbench.runners import run as run_module
 
 DEFAULT_TASK = "spiral"
 DEFAULT_BASELINE = "lstm"
