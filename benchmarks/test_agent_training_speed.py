@@ -1,12 +1,12 @@
 """Closed-loop training speed of every learned agent at the paper's data size, on one CPU thread.
 
 Run with `make bench`. Each case trains an agent's inverse model as `softbench run` does
-(`learned.train_inverse`: its committed hyperparameters, views, forward model sizes and the paper
-profile's compile setting; only the restart of a diverged training is off, so that every case
-times the same epochs) for two epochs on random babbling of the paper's size (14,000 samples in
-10 episodes, cut by the real splitter: 9,800 training and 1,400 validation samples per view). The
-values are random and the forward models untrained, which changes no operation count. The figure
-to read is `extra_info["steady_epoch_s"]`: the second epoch of each model (the first one also
+(`inverse_training.train_inverse`: its committed hyperparameters, views, forward model sizes and the
+paper profile's compile setting; only the restart of a diverged training is off, so that every case
+times the same epochs) for two epochs on random babbling of the paper's size (14,000 samples in 10
+episodes, cut by the real splitter: 9,800 training and 1,400 validation samples per view). The
+values are random and the forward models untrained, which changes no operation count. The figure to
+read is `extra_info["steady_epoch_s"]`: the second epoch of each model (the first one also
 compiles), summed over an SMPL network's columns, i.e. what one epoch of every model costs.
 """
 
@@ -25,8 +25,8 @@ from softbench import data
 from softbench import profiles
 from softbench import robots
 from softbench.agents import hyperparameters
-from softbench.agents import learned
 from softbench.data import dataset as dataset_module
+from softbench.learning import inverse as inverse_training
 
 _EPISODES = 10  # The paper profile's 14,000 samples are 10 episodes of 1,400.
 _EPOCHS = 2  # Per model: the first compiles (where the profile compiles), the second is steady.
@@ -64,14 +64,14 @@ def test_closed_loop_training_epoch(benchmark, agent: str, robot_name: str) -> N
   babbling = _random_babbling(robot, paper.samples)
   windows = [data.windows(babbling, view) for view in views]
   params = hyperparameters.values(agent, robot.name)
-  _, forwards = learned.untrained(views, learner.per_module, learner.make_model, params)
+  _, forwards = inverse_training.untrained(views, learner.per_module, learner.make_model, params)
   forwards = [forward.freeze() for forward in forwards]
   epoch_ends: list[float] = []
 
   def train() -> None:
     epoch_ends.clear()
     epoch_ends.append(time.perf_counter())
-    learned.train_inverse(
+    inverse_training.train_inverse(
       views,
       windows,
       forwards,

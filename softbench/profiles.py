@@ -21,6 +21,16 @@ class Profile:
   episode_length: int | None = None  # Control steps per episode (suite.length_options); None:
   # the task's default.
 
+  def training(self) -> dict:
+    """What a trained model's weights depend on in this profile, by field name: the one reading of
+    a profile by every training config (``softbench.learning``)."""
+    return {
+      "samples": self.samples,
+      "max_epochs": self.max_epochs,
+      "patience": self.patience,
+      "compile": self.compile,
+    }
+
 
 PROFILES = {
   "paper": Profile("paper", samples=14_000, max_epochs=800, patience=50, seeds=5, compile=True),

@@ -4,7 +4,9 @@ rich draws no bars on an output that is not a terminal (a log file of a job in t
 there a bar writes a line of its state instead, at most every ``LOG_INTERVAL_S`` and once more
 when the display stops, in place of rich's last frame (cropped to 80 columns there). In a seed
 worker (``parallel_seeds``), whose bars are not shown, every bar sends its state to the parent
-instead (``relay_to``), which shows a bar per worker."""
+instead (``relay_to``), which shows a bar per worker. ``epochs`` counts a training's epochs,
+``counting`` any work, ``SampleProgress`` samples collected (a babbling collection's, a SAC
+training's environment steps)."""
 
 from collections.abc import Iterable
 import contextlib
@@ -13,6 +15,7 @@ import math
 import os
 import time
 
+from rich import console as rich_console
 from rich import progress as rich_progress
 from rich.text import Text
 
@@ -221,3 +224,40 @@ def counting(
     speed_estimate_period=PACE_WINDOW_S,
     **options,
   )
+
+
+class _RateColumn(rich_progress.ProgressColumn):
+  """Samples per second, averaged over the last ``PACE_WINDOW_S`` (or rich's last 1,000
+  updates)."""
+
+  def render(self, task: rich_progress.Task) -> Text:
+    speed = task.finished_speed or task.speed
+    return Text("? samples/s," if speed is None else f"{speed:.1f} samples/s,")
+
+
+class SampleProgress:
+  """A progress bar on stderr; where ``enabled`` is False, none, but its states still go to the
+  parent from a seed or sweep worker (``relay_to``). ``completed``: where a resumed
+  collection or training starts (not counted in its pace).
+
+  with SampleProgress("tendon-3", total=14000) as bar:
+    bar.update(completed)
+  """
+
+  def __init__(self, description: str, total: int, completed: int = 0, enabled: bool = True):
+    self._progress = counting(
+      enabled,
+      extra=(_RateColumn(), *time_left()),
+      console=rich_console.Console(stderr=True),
+    )
+    self._task = self._progress.add_task(description, total=total, completed=completed)
+
+  def __enter__(self) -> "SampleProgress":
+    self._progress.start()
+    return self
+
+  def __exit__(self, *exception) -> None:
+    self._progress.stop()
+
+  def update(self, completed: int) -> None:
+    self._progress.update(self._task, completed=completed)

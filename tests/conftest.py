@@ -17,9 +17,10 @@ from smpl import training
 from softbench import data
 from softbench import leaderboard
 from softbench import profiles
+from softbench import storage
 from softbench import zoo
-from softbench.agents import learned
 from softbench.data import dataset as data_files
+from softbench.learning import inverse as inverse_training
 from softbench.learning import protocols
 from softbench.runners import continual
 
@@ -42,8 +43,8 @@ def run_folder(tmp_path_factory) -> pathlib.Path:
 @pytest.fixture(scope="session")
 def babbled_datasets(run_folder):
   """``of(robot)``: the datasets folder of a data home holding ``robot``'s tiny babbling dataset
-  (data seed ``learned.DATA_SEED``), collected once per test run: collecting it took most of a
-  tiny training's time. Test processes share that data home as users' processes do (the first
+  (data seed ``inverse_training.DATA_SEED``), collected once per test run: collecting it took most
+  of a tiny training's time. Test processes share that data home as users' processes do (the first
   collects, the others wait for it and read it; their waiting line is not shown)."""
   collected = {}
 
@@ -53,7 +54,10 @@ def babbled_datasets(run_folder):
       with pytest.MonkeyPatch.context() as patched, contextlib.redirect_stderr(io.StringIO()):
         patched.setenv("SOFTBENCH_HOME", str(template))
         data.collect(
-          robot, samples=profiles.get("tiny").samples, seed=learned.DATA_SEED, progress=False
+          robot,
+          samples=profiles.get("tiny").samples,
+          seed=inverse_training.DATA_SEED,
+          progress=False,
         )
       collected[robot] = template / data_files.DATASETS_FOLDER
     return collected[robot]
@@ -176,11 +180,12 @@ def assert_regenerates_identically():
 
 @pytest.fixture
 def assert_one_line_retraining():
-  """Checks that caught warnings hold one ``data.CorruptFileWarning``: one line naming the damaged
-  file and saying that it is trained again."""
+  """Checks that caught warnings hold one ``storage.CorruptFileWarning``: one line naming the
+  damaged file and saying that it is trained again."""
 
   def check(caught, path):
-    (warning,) = [entry for entry in caught if issubclass(entry.category, data.CorruptFileWarning)]
+    corrupt = storage.CorruptFileWarning
+    (warning,) = [entry for entry in caught if issubclass(entry.category, corrupt)]
     message = str(warning.message)
     assert str(path) in message and "training it again" in message and "\n" not in message
 

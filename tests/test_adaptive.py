@@ -10,6 +10,7 @@ from softbench import agents
 from softbench import cli
 from softbench import suite
 from softbench.agents import learned
+from softbench.records import fields
 from softbench.runners import evaluation
 from softbench.runners.adaptive import experiment
 from softbench.runners.adaptive import procedure
@@ -118,12 +119,9 @@ class TestProcedure:
 
 
 def reach_actions(agent, active=None, helpers="hold", seed=0):
-  agent.active_modules, agent.helper_targets = active, helpers
+  acting = agent.with_acting(active_modules=active, helper_targets=helpers)
   env = suite.load(ROBOT, "reach", seed=seed, steps=4)
-  try:
-    return evaluation.run_episode(env, agent, "reach").actions
-  finally:
-    agent.active_modules, agent.helper_targets = None, learned.DEFAULT_HELPER_TARGETS
+  return evaluation.run_episode(env, acting, "reach").actions
 
 
 @pytest.mark.parametrize("agent_name", agents.babbling_learners())
@@ -131,7 +129,7 @@ class TestMasking:
   def test_inactive_modules_get_exactly_zero(self, agent_name):
     agent = agents.make(agent_name, ROBOT, 0, "tiny")
     all_on = reach_actions(agent)
-    for helpers in learned.HELPER_TARGETS:
+    for helpers in fields.HELPER_TARGETS:
       masked = reach_actions(agent, (2,), helpers)
       assert np.all(masked[:, list(MODULE_ENTRIES[1]) + list(MODULE_ENTRIES[3])] == 0.0)
       assert np.all(np.any(masked[:, list(MODULE_ENTRIES[2])] != 0.0, axis=1))
@@ -142,7 +140,7 @@ class TestMasking:
 
   def test_every_module_active_is_the_unmasked_agent_bit_for_bit(self, agent_name):
     agent = agents.make(agent_name, ROBOT, 0, "tiny")
-    for helpers in learned.HELPER_TARGETS:
+    for helpers in fields.HELPER_TARGETS:
       np.testing.assert_array_equal(
         reach_actions(agent, (1, 2, 3), helpers), reach_actions(agent, None, helpers)
       )
@@ -178,7 +176,7 @@ def test_experiment_runs_the_procedure_in_one_continuous_episode():
   # The first stage's error is the mean distance over its steps after the settle step.
   first = np.linalg.norm(outcome.path_mm[2:4] - outcome.target_mm, axis=1).mean()
   assert outcome.stages[0].error == pytest.approx(first, abs=1e-9)
-  assert agent.active_modules is None  # Restored, with the agent's own helpers:
+  assert agent.active_modules is None  # The agent itself is untouched:
   assert agent.helper_targets == learned.DEFAULT_HELPER_TARGETS
 
 
@@ -269,7 +267,7 @@ class TestCompletion:
     env = suite.load(ROBOT, "reach", seed=1, steps=2)
     first = env.reset().observation
     for helpers in ("complete", "nearest"):
-      agent.helper_targets = helpers
+      agent = agent.with_acting(helper_targets=helpers)
       agent.reset(agents.EpisodeInfo("reach", env.task.scored_modules()))
       action = agent.act(first)
       target = agent._previous_target
@@ -277,7 +275,6 @@ class TestCompletion:
       np.testing.assert_array_equal(target[1, :3], first["target"][0])  # The goal itself.
       np.testing.assert_allclose(np.linalg.norm(target[:, 3:], axis=1), 1.0, atol=1e-6)
       assert np.all(np.abs(action) <= 1.0)
-    agent.helper_targets = learned.DEFAULT_HELPER_TARGETS
 
   def test_completion_is_deterministic_and_differs_from_hold(self, agent_name):
     agent = agents.make(agent_name, ROBOT, 0, "tiny")
@@ -292,9 +289,8 @@ class TestCompletion:
     agent = agents.make(agent_name, ROBOT, 0, "tiny")
     env = lambda: suite.load(ROBOT, "circle", seed=0, length=3)
     runs = []
-    for helpers in learned.HELPER_TARGETS:
-      agent.helper_targets = helpers
-      runs.append(evaluation.run_episode(env(), agent, "circle").actions)
-    agent.helper_targets = learned.DEFAULT_HELPER_TARGETS
+    for helpers in fields.HELPER_TARGETS:
+      acting = agent.with_acting(helper_targets=helpers)
+      runs.append(evaluation.run_episode(env(), acting, "circle").actions)
     for actions in runs[1:]:
       np.testing.assert_array_equal(actions, runs[0])

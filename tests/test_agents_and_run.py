@@ -14,7 +14,6 @@ import torch
 
 from softbench import agents
 from softbench import cli
-from softbench import data
 from softbench import profiles
 from softbench import records
 from softbench import robots
@@ -22,8 +21,10 @@ from softbench import storage
 from softbench import suite
 from softbench import terminal
 from softbench.agents import learned
+from softbench.learning import checkpoints
 from softbench.learning import forward_models
 from softbench.learning import protocols
+from softbench.records import fields
 from softbench.runners import evaluation
 from softbench.runners import parallel_seeds
 from softbench.runners import run
@@ -75,13 +76,13 @@ def test_training_is_deterministic_and_its_checkpoint_round_trips(
   scratch, to the same actions. Another seed (the run-wide home's seed 0) acts otherwise."""
   babbled_home(tmp_path)
   trained = episode(agent_name, "tendon-2", "circle", 1)  # Trains, then saves the checkpoint.
-  (checkpoint,) = (tmp_path / learned.CHECKPOINT_FOLDER).glob(f"{agent_name}-*.pt")
+  (checkpoint,) = (tmp_path / checkpoints.CHECKPOINT_FOLDER).glob(f"{agent_name}-*.pt")
   loaded = episode(agent_name, "tendon-2", "circle", 1)
   np.testing.assert_array_equal(trained.actions, loaded.actions)
   checkpoint.write_bytes(checkpoint.read_bytes()[:1000])
   if (tmp_path / forward_models.FOLDER).exists():  # sac learns without forward models.
     shutil.rmtree(tmp_path / forward_models.FOLDER)
-  with pytest.warns(data.CorruptFileWarning) as caught:
+  with pytest.warns(storage.CorruptFileWarning) as caught:
     retrained = episode(agent_name, "tendon-2", "circle", 1)
   assert_one_line_retraining(caught, checkpoint)
   np.testing.assert_array_equal(retrained.actions, trained.actions)
@@ -102,7 +103,7 @@ def test_a_damaged_cached_forward_model_is_trained_again(
   babbled_home(tmp_path)
   agents.make("mlp", "tendon-2", 0, "tiny")
   (forward,) = (tmp_path / forward_models.FOLDER).glob("*.pt")
-  (checkpoint,) = (tmp_path / learned.CHECKPOINT_FOLDER).glob("mlp-*.pt")
+  (checkpoint,) = (tmp_path / checkpoints.CHECKPOINT_FOLDER).glob("mlp-*.pt")
   written = torch.load(checkpoint, weights_only=True)["state_dict"]
   checkpoint.unlink()  # The agent trains again, from the cached forward model.
   content = bytearray(forward.read_bytes())
@@ -113,7 +114,7 @@ def test_a_damaged_cached_forward_model_is_trained_again(
     values = state[max(state, key=lambda name: state[name].numel())].numpy().tobytes()
     content[bytes(content).index(values) + 2] ^= 0x01
   forward.write_bytes(bytes(content))
-  with pytest.warns(data.CorruptFileWarning) as caught:
+  with pytest.warns(storage.CorruptFileWarning) as caught:
     agents.make("mlp", "tendon-2", 0, "tiny")
   assert_one_line_retraining(caught, forward)
   again = torch.load(checkpoint, weights_only=True)["state_dict"]
@@ -133,7 +134,7 @@ def test_a_folder_at_a_checkpoint_path_is_damage_reported_and_replaced(
   path = learned.checkpoint_path("mlp", robots.make("tendon-2"), 0, profiles.get("tiny"), False)
   (path / "stray.txt").parent.mkdir(parents=True)
   (path / "stray.txt").write_text("not a checkpoint")
-  with pytest.warns(data.CorruptFileWarning) as caught:
+  with pytest.warns(storage.CorruptFileWarning) as caught:
     agents.make("mlp", "tendon-2", 0, "tiny")
   assert_one_line_retraining(caught, path)
   assert path.is_file()
@@ -152,13 +153,13 @@ def test_interrupted_training_resumes_to_the_same_checkpoint(
   # with a forward model per module) a forward model's in its cache file's folder.
   assert list(tmp_path.rglob("*.partial/fit-1.pt"))
   agents.make(agent_name, "tendon-2", 0, "tiny")
-  (checkpoint,) = (tmp_path / learned.CHECKPOINT_FOLDER).glob(f"{agent_name}-*.pt")
+  (checkpoint,) = (tmp_path / checkpoints.CHECKPOINT_FOLDER).glob(f"{agent_name}-*.pt")
   resumed = torch.load(checkpoint, weights_only=False)["state_dict"]
   assert not list(tmp_path.rglob("*.partial"))
   run_wide_home("tendon-2")  # Its agents are trained once per run.
   agents.make(agent_name, "tendon-2", 0, "tiny")
   uninterrupted = torch.load(
-    storage.softbench_home() / learned.CHECKPOINT_FOLDER / checkpoint.name, weights_only=False
+    storage.softbench_home() / checkpoints.CHECKPOINT_FOLDER / checkpoint.name, weights_only=False
   )["state_dict"]
   assert resumed.keys() == uninterrupted.keys()
   assert all(torch.equal(resumed[key], uninterrupted[key]) for key in resumed)
@@ -177,7 +178,7 @@ def test_agents_reading_the_same_view_share_one_forward_model(tmp_path, monkeypa
     babbled_home(home)
     for name in agent_names:
       agents.make(name, "tendon-2", 0, "tiny")
-    (path,) = (home / learned.CHECKPOINT_FOLDER).glob("lstm-*.pt")
+    (path,) = (home / checkpoints.CHECKPOINT_FOLDER).glob("lstm-*.pt")
     return torch.load(path, weights_only=False)["state_dict"]
 
   alone = lstm_weights(tmp_path / "alone", ["lstm"])
@@ -190,20 +191,19 @@ def test_agents_reading_the_same_view_share_one_forward_model(tmp_path, monkeypa
 
 def test_a_checkpoints_further_arrays_may_not_use_a_parts_name(tmp_path):
   # They would be read back as that part's normalisation.
-  clashing = learned.TrainedModels(None, [], [], {"module-1/mean": np.zeros(3)})
+  clashing = checkpoints.TrainedModels(None, [], [], {"module-1/mean": np.zeros(3)})
   with pytest.raises(ValueError, match="clash"):
-    learned.load_or_train(tmp_path / "agent.pt", None, ["module-1"], None, lambda: clashing)
+    checkpoints.load_or_train(tmp_path / "agent.pt", None, ["module-1"], None, lambda: clashing)
   assert not (tmp_path / "agent.pt").exists()
 
 
-@pytest.mark.parametrize("mode", learned.ERROR_SOURCES)
+@pytest.mark.parametrize("mode", fields.ERROR_SOURCES)
 def test_error_sources_differ_after_the_first_step(mode):
-  agent = agents.make("smpl", "tendon-2", 0, "tiny")
-  agent.error_source = mode
+  agent = agents.make("smpl", "tendon-2", 0, "tiny", acting=learned.Acting(mode))
   env = suite.load("tendon-2", "circle", seed=0, length=4)
   actions = evaluation.run_episode(env, agent, "circle").actions
-  agent.error_source = "open-loop"
-  open_loop = evaluation.run_episode(env, agent, "circle").actions
+  open_loop = evaluation.run_episode(env, agent.with_acting(error_source="open-loop"), "circle")
+  open_loop = open_loop.actions
   np.testing.assert_array_equal(actions[0], open_loop[0])  # e_0 = 0 in every mode.
   assert np.array_equal(actions, open_loop) == (mode == "open-loop")
 

@@ -16,8 +16,8 @@ from softbench import data
 from softbench import records
 from softbench import robots
 from softbench.agents import hyperparameters
-from softbench.agents import learned
 from softbench.agents import learners
+from softbench.learning import inverse as inverse_training
 from softbench.robots import versions
 from softbench.runners import run
 
@@ -266,7 +266,7 @@ def test_smpl_joint_columns_trains_every_column_at_once_and_reads_the_record(
   recorded = f"{record['per_seed'][0]['position_mm']['mean']:.4f}"
   assert f"the record: {recorded} mm" in line
   arm = robots.make("tendon-2")
-  network, _ = learned.untrained(
+  network, _ = inverse_training.untrained(
     learners.views(arm, per_module=True), True, None, hyperparameters.values("smpl", arm.name)
   )
   assert f"({sum(p.numel() for p in network.parameters()):,} parameters trained" in line

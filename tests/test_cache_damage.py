@@ -16,12 +16,13 @@ from softbench import data
 from softbench import profiles
 from softbench import storage
 from softbench import suite
-from softbench.agents import learned
 from softbench.data import babbling
 from softbench.data import chunks
 from softbench.data import dataset
 from softbench.episodes import snapshots as episode_snapshots
+from softbench.learning import checkpoints
 from softbench.learning import forward_models
+from softbench.learning import inverse as inverse_training
 from softbench.runners import evaluation
 from softbench.runners import run
 from softbench.suite import references
@@ -58,7 +59,7 @@ def _agent() -> dict:
 
 def _forward() -> dict:
   arm = suite.robots.make(ROBOT)
-  _, (model,) = learned.trained_forward_models(
+  _, (model,) = inverse_training.trained_forward_models(
     arm, [data.View.whole_arm(arm)], 0, profiles.get("tiny")
   )
   return {name: tensor.numpy() for name, tensor in model.state_dict().items()}
@@ -123,7 +124,7 @@ CACHES = {
     _reference, lambda home: _only(home, "references/*.json"), zip=False
   ),
   "checkpoint": Cache(
-    _agent, lambda home: _only(home, f"{learned.CHECKPOINT_FOLDER}/*.pt"), trained=True
+    _agent, lambda home: _only(home, f"{checkpoints.CHECKPOINT_FOLDER}/*.pt"), trained=True
   ),
   "forward model": Cache(
     _forward, lambda home: _only(home, f"{forward_models.FOLDER}/*.pt"), trained=True

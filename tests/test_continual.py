@@ -7,12 +7,12 @@ import pytest
 import torch
 
 from softbench import cli
-from softbench import data
 from softbench import profiles
 from softbench import records
 from softbench import robots
-from softbench.agents import learned
+from softbench import storage
 from softbench.episodes import snapshots as episode_snapshots
+from softbench.learning import checkpoints
 from softbench.runners import continual
 
 
@@ -143,9 +143,9 @@ def test_a_damaged_cached_network_is_trained_again(
 ):
   tiny = profiles.get("tiny")
   first = continual.build(0, tiny)
-  (path,) = (tmp_path / "home" / learned.CHECKPOINT_FOLDER).glob("exp1s-*.pt")
+  (path,) = (tmp_path / "home" / checkpoints.CHECKPOINT_FOLDER).glob("exp1s-*.pt")
   path.write_bytes(b"hello")
-  with pytest.warns(data.CorruptFileWarning) as caught:
+  with pytest.warns(storage.CorruptFileWarning) as caught:
     again = continual.build(0, tiny)
   assert_one_line_retraining(caught, path)
   first_state, again_state = first.network.state_dict(), again.network.state_dict()

@@ -180,7 +180,7 @@ def test_corrupt_chunk_is_reported_and_recomputed(monkeypatch, reference_bytes, 
   else:
     content = content[: len(content) // 2]
   second.write_bytes(bytes(content))
-  with pytest.warns(data.CorruptFileWarning, match="chunk-000002-000004.npz"):
+  with pytest.warns(storage.CorruptFileWarning, match="chunk-000002-000004.npz"):
     resumed = collect()
   assert resumed.collection["resumed_from_step"] == CHUNK
   assert npz_bytes(resumed) == reference_bytes
@@ -199,7 +199,7 @@ def test_a_chunk_of_another_collection_is_refused(monkeypatch, reference_bytes):
   (foreign,) = (dataset.dataset_folder(foreign_config) / chunks.PARTIAL_FOLDER).iterdir()
   partial_folder(small_config()).mkdir(parents=True)
   (partial_folder(small_config()) / foreign.name).write_bytes(foreign.read_bytes())
-  with pytest.warns(dataset.CorruptFileWarning, match="a chunk of another collection"):
+  with pytest.warns(storage.CorruptFileWarning, match="a chunk of another collection"):
     resumed = collect()
   assert resumed.collection["resumed_from_step"] == 0
   assert npz_bytes(resumed) == reference_bytes
@@ -213,7 +213,7 @@ def test_a_folder_where_the_dataset_file_belongs_is_replaced(manifest, reference
     collect()
   (folder / dataset.NPZ_NAME).unlink(missing_ok=True)
   (folder / dataset.NPZ_NAME / "stray").mkdir(parents=True)
-  with pytest.warns(dataset.CorruptFileWarning) as caught:
+  with pytest.warns(storage.CorruptFileWarning) as caught:
     collected = collect()
   assert len(caught) == 1 and str(folder / dataset.NPZ_NAME) in str(caught[0].message)
   assert npz_bytes(collected) == reference_bytes
@@ -321,7 +321,7 @@ def test_damaged_dataset_raises_one_line_dataset_error(damage):
 
 def test_collect_replaces_a_damaged_dataset(reference_bytes):
   _flip_npz(collect().path)
-  with pytest.warns(data.CorruptFileWarning, match=dataset.NPZ_NAME):
+  with pytest.warns(storage.CorruptFileWarning, match=dataset.NPZ_NAME):
     assert npz_bytes(collect()) == reference_bytes
 
 

@@ -11,13 +11,13 @@ import torch
 
 from softbench import agents
 from softbench import cli
-from softbench import data
 from softbench import profiles
 from softbench import robots
 from softbench import storage
 from softbench import suite
 from softbench.agents import adaptation
 from softbench.agents import learned
+from softbench.learning import checkpoints
 from softbench.robots import faults
 from softbench.runners import retrain
 
@@ -329,11 +329,11 @@ def test_a_damaged_retrained_column_is_trained_again(assert_one_line_retraining)
   faulty = healthy.with_faults([faults.parse("1:0:0.5")])
   smpl = agents.make("smpl", healthy, 0, "tiny")
   first = adaptation.retrain_column(smpl, faulty, profiles.get("tiny"))  # Trained or cached.
-  (path,) = (storage.softbench_home() / learned.CHECKPOINT_FOLDER).glob(
+  (path,) = (storage.softbench_home() / checkpoints.CHECKPOINT_FOLDER).glob(
     "smpl-tendon-2-fault1.0.0.5-*.pt"
   )
   path.write_bytes(b"hello")
-  with pytest.warns(data.CorruptFileWarning) as caught:
+  with pytest.warns(storage.CorruptFileWarning) as caught:
     again = adaptation.retrain_column(smpl, faulty, profiles.get("tiny"))
   assert_one_line_retraining(caught, path)
   assert again.trained_now and again.wall_time_s == adaptation.read_wall_time(path)
@@ -355,6 +355,6 @@ def test_the_baselines_timing_notices_a_damaged_checkpoint_trained_again():
     settings.baseline, faulty, 0, settings.run.profile, per_module=False
   )
   path.write_bytes(path.read_bytes()[:500])
-  with pytest.warns(data.CorruptFileWarning):
+  with pytest.warns(storage.CorruptFileWarning):
     _, seconds, trained_now = retrain._timed_baseline(settings, faulty, 0, False)
   assert trained_now and seconds == adaptation.read_wall_time(path) and seconds > 0

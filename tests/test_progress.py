@@ -12,7 +12,6 @@ from rich import progress as rich_progress
 
 from smpl import training
 from softbench import progress
-from softbench.data import progress as sample_progress
 from softbench.sweep import display
 
 
@@ -198,7 +197,7 @@ def test_a_sweeps_time_left_comes_from_its_pace_when_its_tasks_end_minutes_apart
 def test_a_sample_bar_updated_a_minute_apart_shows_its_rate_and_time_left(monkeypatch):
   # A SAC training's bar: one update per 1,000-step chunk.
   now = _clocked(monkeypatch)
-  with sample_progress.SampleProgress("sac", total=30_000, enabled=False) as bar:
+  with progress.SampleProgress("sac", total=30_000, enabled=False) as bar:
     for chunk in range(1, 4):
       now[0] = 60.0 * chunk
       bar.update(1_000 * chunk)
@@ -215,7 +214,7 @@ def test_a_hidden_sample_bar_in_a_worker_is_relayed_from_where_it_resumed(capsys
   monkeypatch.setattr(progress, "RELAY_INTERVAL_S", 0.0)
   monkeypatch.setattr(progress, "LOG_INTERVAL_S", 0.0)
   now, sent = _clocked(monkeypatch), []
-  with sample_progress.SampleProgress("sac tendon-3 seed 1", 30_000, 12_000, False) as bar:
+  with progress.SampleProgress("sac tendon-3 seed 1", 30_000, 12_000, False) as bar:
     for chunk in range(1, 4):
       now[0] = 60.0 * chunk
       bar.update(12_000 + 1_000 * chunk)

@@ -13,11 +13,11 @@ from smpl import snapshots
 from softbench import data
 from softbench import profiles
 from softbench import robots
-from softbench.agents import learned
 from softbench.agents import sac
 from softbench.data import splits
 from softbench.envs import environment
 from softbench.envs import streams
+from softbench.learning import inverse as inverse_training
 
 ROBOT = "tendon-1"
 TINY = profiles.get("tiny")
@@ -84,7 +84,9 @@ def test_an_interrupted_training_resumes_to_the_same_weights(
 
 def test_training_episodes_follow_training_stretches_fixed_by_the_seed(home):
   arm = robots.make(ROBOT)
-  dataset = data.collect(ROBOT, samples=TINY.samples, seed=learned.DATA_SEED, progress=False)
+  dataset = data.collect(
+    ROBOT, samples=TINY.samples, seed=inverse_training.DATA_SEED, progress=False
+  )
   stream = streams.training_targets(dataset, 10)
   env = streams.TargetStreamEnv(arm, stream, 10, seed=4)
   later = streams.TargetStreamEnv(arm, stream, 10, seed=4, first_episode=2)

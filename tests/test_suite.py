@@ -16,9 +16,9 @@ from softbench import agents
 from softbench import cli
 from softbench import data
 from softbench import robots
+from softbench import storage
 from softbench import suite
 from softbench import terminal
-from softbench.data import dataset
 from softbench.robots import recorder
 from softbench.suite import references
 
@@ -199,7 +199,7 @@ def test_reference_is_cached_and_a_corrupt_cache_is_regenerated(monkeypatch, tmp
   data[len(data) // 2] ^= 0xFF
   npz.write_bytes(bytes(data))
   unreadable = re.escape(f"{npz}: unreadable cached reference")
-  with pytest.warns(dataset.CorruptFileWarning, match=unreadable):
+  with pytest.warns(storage.CorruptFileWarning, match=unreadable):
     regenerated = references.reference(arm, "circle", length=5)
   np.testing.assert_array_equal(regenerated.poses, first.poses)
   meta = json.loads(npz.with_suffix(".json").read_text())
@@ -231,7 +231,7 @@ def test_a_malformed_cached_reference_description_is_regenerated(
   first = references.reference(arm, "circle", length=4)
   (meta,) = (tmp_path / "references").glob("*.json")
   meta.write_text(description)
-  with pytest.warns(dataset.CorruptFileWarning, match="unreadable cached reference"):
+  with pytest.warns(storage.CorruptFileWarning, match="unreadable cached reference"):
     regenerated = references.reference(arm, "circle", length=4)
   np.testing.assert_array_equal(regenerated.poses, first.poses)
   assert json.loads(meta.read_text())["config"]["shape"] == "circle"
@@ -246,7 +246,7 @@ def test_a_damaged_reference_warns_on_one_softbench_line(monkeypatch, tmp_path):
   references.reference(arm, "circle", length=4)
   (meta,) = (tmp_path / "references").glob("*.json")
   meta.write_text("null")
-  with pytest.warns(dataset.CorruptFileWarning) as caught:
+  with pytest.warns(storage.CorruptFileWarning) as caught:
     references.reference(arm, "circle", length=4)
   monkeypatch.setattr(warnings, "formatwarning", warnings.formatwarning)
   terminal.one_line_warnings()  # As the command line prints warnings.

@@ -28,6 +28,7 @@ from softbench import storage
 from softbench import sweep
 from softbench import zoo
 from softbench.agents import learned
+from softbench.learning import exp1s as exp1s_training
 from softbench.learning import protocols
 from softbench.runners import continual
 from softbench.runners import run
@@ -238,7 +239,7 @@ def test_exp1s_in_a_sweep_writes_the_record_softbench_run_writes(
     ray_with_worker_hook(address, worker_hooks.shorten_exp1s),
   ):
     patch.setitem(protocols.PROTOCOLS, continual.PROTOCOL, worker_hooks.shortened_exp1s())
-    for stage in continual.protocol(family).robot_names:  # Given to softbench run's home only.
+    for stage in exp1s_training.protocol(family).robot_names:  # Given to softbench run's home only.
       with_babbled_dataset(tmp_path / "run-home", stage)
     with pytest.MonkeyPatch.context() as home:  # softbench run's record, in a home of its own.
       home.setenv(storage.HOME_VARIABLE, str(tmp_path / "run-home"))

@@ -13,7 +13,8 @@ from softbench import profiles
 from softbench import robots
 from softbench import tuning
 from softbench.agents import hyperparameters
-from softbench.agents import learned
+from softbench.learning import checkpoints
+from softbench.learning import inverse as inverse_training
 
 LEARNED = agents.babbling_learners()  # The agents tuning takes.
 
@@ -124,14 +125,14 @@ def test_committed_values_fit_every_learned_agent(agent):
   assert params == table["agents"][agent][table["default_robot"]]["params"]
   learner = tuning.study.learner(agent)
   views = learner.views(arm)
-  model = learned._inverse_model(views, learner.per_module, learner.make_model, params)
+  model = inverse_training._inverse_model(views, learner.per_module, learner.make_model, params)
   assert model.action_size == (views[-1].action_size if learner.per_module else arm.action_dim)
   # Every tuned setting reaches the model or the optimiser.
-  _, config = learned.training_configs(0, profiles.get("tiny"), params)
-  for name, value in hyperparameters.training_settings(params).items():
+  _, config = inverse_training.training_configs(0, profiles.get("tiny"), params)
+  for name, value in inverse_training.training_settings(params).items():
     assert getattr(config, name) == value
   factory = inspect.signature(learner.make_model).parameters if not learner.per_module else {}
-  assert set(hyperparameters.model_settings(params)) <= set(factory)
+  assert set(inverse_training.model_settings(params)) <= set(factory)
 
 
 @pytest.mark.parametrize("agent", LEARNED)
@@ -139,7 +140,7 @@ def test_a_changed_value_changes_the_checkpoint_key(agent, tmp_path, monkeypatch
   arm, profile = robots.make("tendon-3"), profiles.get("tiny")
   views = tuning.study.learner(agent).views(arm)
   key = lambda: (
-    learned.trained_config(
+    checkpoints.trained_config(
       agent, arm, views, 0, profile, hyperparameters.values(agent, arm.name)
     ).key
   )
@@ -163,7 +164,7 @@ def test_learned_agents_train_with_the_committed_values(tmp_path, monkeypatch, b
   monkeypatch.setattr(hyperparameters, "PATH", changed)
   agent = agents.make("mlp", "tendon-2", 0, "tiny")  # A new checkpoint, not the stale one.
   assert agent.inverse.network[0].out_features == 32
-  assert len(list((tmp_path / "home" / learned.CHECKPOINT_FOLDER).glob("mlp-*.pt"))) == 2
+  assert len(list((tmp_path / "home" / checkpoints.CHECKPOINT_FOLDER).glob("mlp-*.pt"))) == 2
 
 
 @pytest.mark.parametrize(

@@ -19,6 +19,7 @@ from softbench import zoo
 from softbench.agents import learned
 from softbench.data import dataset as data_files
 from softbench.leaderboard import verified
+from softbench.learning import checkpoints
 from softbench.learning import protocols
 from softbench.robots import versions
 from softbench.runners import evaluation
@@ -122,7 +123,7 @@ def test_a_tampered_zoo_file_is_refused_in_one_line_and_the_agent_trained(
   # The zoo checks bytes, whatever the agent: one agent shows it.
   agent_name = "mlp"
   folder, trained = zoo_of(agent_name)
-  (checkpoint,) = folder.glob(f"{learned.CHECKPOINT_FOLDER}/{agent_name}-*.pt")
+  (checkpoint,) = folder.glob(f"{checkpoints.CHECKPOINT_FOLDER}/{agent_name}-*.pt")
   content = bytearray(checkpoint.read_bytes())
   content[len(content) // 2] ^= 1  # One bit of the weights.
   checkpoint.write_bytes(bytes(content))
@@ -161,7 +162,7 @@ def test_an_unreadable_manifest_is_one_warning_and_the_agent_trains(
 
 
 def test_a_manifest_path_outside_the_zoo_is_refused(tmp_path):
-  entry = zoo.Entry("../outside.pt", "0" * 64, 1, "agent", "outside")
+  entry = zoo.ZooFile("../outside.pt", "0" * 64, 1, "agent", "outside")
   (tmp_path / zoo.MANIFEST).write_text(
     json.dumps({"format": zoo.FORMAT, "version": zoo.VERSION, "entries": [entry.to_json()]})
   )
@@ -170,33 +171,27 @@ def test_a_manifest_path_outside_the_zoo_is_refused(tmp_path):
 
 
 @pytest.mark.parametrize("agent_name", LEARNED_AGENTS)
-def test_an_unfinished_training_goes_on_from_the_zoo_in_another_home(
-  agent_name, trained_zoos, interrupted_training, babbled, tmp_path, monkeypatch, capsys
+def test_the_zoo_takes_no_unfinished_training(
+  agent_name, interrupted_training, babbled, tmp_path, monkeypatch
 ):
-  _, uninterrupted = trained_zoos(agent_name)
   use(monkeypatch, tmp_path / "first", datasets=babbled)
   with interrupted_training():
     actions(agent_name)
   chosen = catalogue.setting(agent_name, ROBOT, None, "tiny", 1)
   files = [(path, kind) for _, path, kind in catalogue.cache_files(chosen)]
+  unfinished = [path for path, _ in files if not path.exists()]
+  assert any(checkpoints.snapshot_folder(path).is_dir() for path in unfinished)
+  finished = [(path, kind) for path, kind in files if path.exists()]
+  if not finished:
+    with pytest.raises(ValueError, match="^nothing of this setting has finished training"):
+      zoo.add(files, {}, tmp_path / "zoo")
+    return
   added, skipped = zoo.add(files, {}, tmp_path / "zoo")
-  assert "training-state" in {entry.kind for entry in added}
-  assert skipped == [
-    path
-    for path, _ in files  # Not started when the training stopped.
-    if not path.exists() and not path.with_suffix(zoo.PARTIAL_SUFFIX).exists()
-  ]
-  capsys.readouterr()
-  # Another machine's home, with the dataset (which the zoo does not carry) but no training.
-  use(monkeypatch, tmp_path / "second", tmp_path / "zoo", datasets=babbled)
-  np.testing.assert_array_equal(actions(agent_name), uninterrupted)
-  assert "softbench: zoo: resuming the training of" in capsys.readouterr().err
-  # Once finished, its checkpoint replaces the training state in the zoo.
-  zoo.add([(path, kind) for _, path, kind in catalogue.cache_files(chosen)], {}, tmp_path / "zoo")
-  entries = zoo.read_manifest(tmp_path / "zoo")
-  assert {entry.kind for entry in entries.values()} <= {"agent", "forward"}
-  assert not list((tmp_path / "zoo").rglob("*.partial"))
-  assert zoo.check_files(tmp_path / "zoo") == []
+  assert skipped == unfinished
+  assert sorted(entry.path for entry in added) == sorted(
+    path.relative_to(tmp_path / "first").as_posix() for path, _ in finished
+  )
+  assert not list((tmp_path / "zoo").rglob("*.partial*"))
 
 
 def test_the_zoo_refuses_to_outgrow_its_budget(babbled, zoo_of, tmp_path, monkeypatch):
@@ -213,7 +208,7 @@ def test_the_zoo_refuses_to_outgrow_its_budget(babbled, zoo_of, tmp_path, monkey
       budget_bytes=zoo.size_bytes(zoo.read_manifest(folder)),
     )
   assert (folder / zoo.MANIFEST).read_bytes() == before
-  assert not list(folder.glob(f"{learned.CHECKPOINT_FOLDER}/lstm-*"))
+  assert not list(folder.glob(f"{checkpoints.CHECKPOINT_FOLDER}/lstm-*"))
 
 
 def test_removing_an_agent_keeps_the_forward_models_that_another_agent_in_the_zoo_reads(
@@ -394,7 +389,7 @@ def test_verify_reports_a_record_the_zoo_does_not_reproduce(babbled, tmp_path, m
     "softbench: error: 1 re-scored seeds differ from their records"
   ]
   # A damaged zoo file is named before anything is re-scored.
-  (checkpoint,) = (tmp_path / "zoo" / learned.CHECKPOINT_FOLDER).glob("*.pt")
+  (checkpoint,) = (tmp_path / "zoo" / checkpoints.CHECKPOINT_FOLDER).glob("*.pt")
   checkpoint.write_bytes(checkpoint.read_bytes()[:-1])
   assert (
     cli.main(
@@ -423,7 +418,7 @@ def test_zoo_add_links_only_the_records_its_weights_made(babbled, tmp_path, monk
     for _, path, _ in catalogue.cache_files(chosen)
   }
   other = json.loads(json.dumps(record))  # Scored with other weights (a retrained checkpoint).
-  checkpoint = next(path for path in named if path.startswith(learned.CHECKPOINT_FOLDER))
+  checkpoint = next(path for path in named if path.startswith(checkpoints.CHECKPOINT_FOLDER))
   other["weights"]["per_seed"][0]["files"][checkpoint] = "0" * 64
   _reseal(other, tmp_path / "results" / made.name.replace(".json", "-other.json"))
   older = {key: value for key, value in record.items() if key != "weights"}  # Names none.
@@ -550,6 +545,9 @@ def test_the_repositorys_zoo_is_intact_within_its_budget_and_links_committed_rec
   assert zoo.check_files(committed) == []  # Every file listed, with its sha256; none unlisted.
   assert all((committed / path).stat().st_size == entry.bytes for path, entry in entries.items())
   assert zoo.size_bytes(entries) <= zoo.BUDGET_BYTES
+  # Finished weights only: an unfinished training's state grows the history at every save.
+  assert {entry.kind for entry in entries.values()} <= set(zoo.KINDS) == {"agent", "forward"}
+  assert not [path for path in committed.rglob("*") if ".partial" in path.name]
   linked = {record for entry in entries.values() for record in entry.records}
   missing = sorted(linked - {path.name for path in (CHECKOUT / "leaderboard/results").iterdir()})
   assert not missing, f"the zoo links records that leaderboard/results lacks: {missing}"

@@ -22,6 +22,7 @@ from softbench import profiles
 from softbench import robots
 from softbench.agents import hyperparameters
 from softbench.agents import learned
+from softbench.learning import inverse as inverse_training
 from softbench.runners import run
 from softbench.tuning import study
 
@@ -42,12 +43,12 @@ def main() -> None:
   if learner is None or learner.per_module:
     raise SystemExit(f"{args.agent} trains column by column; pick a centralised agent")
   (view,) = views = learner.views(arm)
-  windows, forwards = learned.trained_forward_models(arm, views, args.seed, profile)
+  windows, forwards = inverse_training.trained_forward_models(arm, views, args.seed, profile)
   params = hyperparameters.values(args.agent, arm.name)
-  _, config = learned.training_configs(args.seed, profile, params)
+  _, config = inverse_training.training_configs(args.seed, profile, params)
   config = dataclasses.replace(config, max_epochs=args.epochs, patience=args.epochs + 1)
   with training.seeded(args.seed, torch.device("cpu")):
-    inverse = learned._inverse_model(views, False, learner.make_model, params)
+    inverse = inverse_training._inverse_model(views, False, learner.make_model, params)
 
   kept = {}
 

@@ -26,7 +26,8 @@ from smpl import windows as smpl_windows
 from softbench import data
 from softbench import profiles
 from softbench import suite
-from softbench.agents import learned
+from softbench.agents import hyperparameters
+from softbench.learning import inverse as inverse_training
 from softbench.learning import protocols
 from softbench.runners import continual
 from softbench.runners import evaluation
@@ -57,19 +58,21 @@ def main() -> None:
   column_views = protocols.get(continual.PROTOCOL).column_views()
   if not 1 <= stage < len(column_views):
     raise SystemExit(f"--configuration must be 2 to {len(column_views)}")
-  path = learned.checkpoint_file(
-    continual._config(args.seed, profile, [arm for arm, _ in column_views])
-  )
+  path = continual.checkpoint_path(args.seed, profile)
   if not path.exists():
     raise SystemExit(f"no cached Exp1S network {path}; run softbench run --protocol exp1s first")
   model = continual.build(args.seed, profile)
   arm, view = column_views[stage]
-  dataset = data.collect(arm, samples=profile.samples, seed=learned.DATA_SEED, progress=False)
+  dataset = data.collect(
+    arm, samples=profile.samples, seed=inverse_training.DATA_SEED, progress=False
+  )
   windows = data.windows(dataset, view)
   forward = model.controllers[stage].forward.requires_grad_(False)
   task = smpl_protocol.ColumnTask(windows.train, windows.validation, windows.test, forward)
   trained = model.network.state_dict()
-  _, tuned = learned.training_configs(args.seed, profile, continual._params(model.arms[-1].name))
+  _, tuned = inverse_training.training_configs(
+    args.seed, profile, hyperparameters.values("smpl", model.arms[-1].name)
+  )
 
   for learning_rate, pose_loss_weight in args.settings:
     network = progressive.ProgressiveLSTM()

@@ -20,7 +20,7 @@ import numpy as np
 
 from softbench import agents
 from softbench import suite
-from softbench.agents import learned
+from softbench.records import fields
 from softbench.runners import evaluation
 
 QUARTILES = (25, 50, 75)  # (%) Percentiles reported over targets.
@@ -50,10 +50,9 @@ def main() -> None:
   table = {}
   for name in args.agents.split(","):
     agent = agents.make(name, args.robot, 0, args.profile)
-    for helpers in learned.HELPER_TARGETS:
-      agent.helper_targets = helpers
+    for helpers in fields.HELPER_TARGETS:
       started = time.perf_counter()
-      errors = errors_mm(agent, args.robot, args.targets)
+      errors = errors_mm(agent.with_acting(helper_targets=helpers), args.robot, args.targets)
       row = {
         "episode_mean_mm": np.percentile(errors[:, 0], QUARTILES).round(2).tolist(),
         "final_mm": np.percentile(errors[:, 1], QUARTILES).round(2).tolist(),

@@ -27,6 +27,7 @@ from softbench import profiles
 from softbench import robots
 from softbench.agents import hyperparameters
 from softbench.agents import learned
+from softbench.learning import inverse as inverse_training
 from softbench.runners import run
 
 VIEWS = {
@@ -50,9 +51,9 @@ def main() -> None:
   for seed in args.seeds:
     for name in args.views:
       views = [VIEWS[name](arm, module) for module in range(1, arm.num_modules + 1)]
-      windows, forwards = learned.trained_forward_models(arm, views, seed, profile)
+      windows, forwards = inverse_training.trained_forward_models(arm, views, seed, profile)
       started = time.perf_counter()
-      inverse, validation_loss = learned.train_inverse(
+      inverse, validation_loss = inverse_training.train_inverse(
         views, windows, forwards, seed, profile, True, None, params
       )
       trained_s = time.perf_counter() - started

@@ -34,6 +34,7 @@ from softbench import robots
 from softbench.agents import hyperparameters
 from softbench.agents import learned
 from softbench.agents import learners
+from softbench.learning import inverse as inverse_training
 from softbench.runners import run
 
 
@@ -82,12 +83,12 @@ def main() -> None:
   settings = run.settings(args.task, "smpl", args.robot, seeds=1, profile=args.profile)
   device = training.default_device()
   for seed in args.seeds:
-    windows, forwards = learned.trained_forward_models(arm, views, seed, profile)
+    windows, forwards = inverse_training.trained_forward_models(arm, views, seed, profile)
     check_preceding_is_proximal(windows)
     with training.seeded(seed, torch.device("cpu")):
-      network, _ = learned.untrained(views, True, None, params)
+      network, _ = inverse_training.untrained(views, True, None, params)
     network.requires_grad_(True)  # Adding a column froze the ones before it.
-    _, config = learned.training_configs(seed, profile, params)
+    _, config = inverse_training.training_configs(seed, profile, params)
     config = dataclasses.replace(config, max_epochs=profile.max_epochs * arm.num_modules)
     for model in forwards:
       model.to(device).eval()

@@ -23,6 +23,7 @@ from softbench import robots
 from softbench.agents import hyperparameters
 from softbench.agents import learned
 from softbench.agents import learners
+from softbench.learning import inverse as inverse_training
 from softbench.runners import run
 
 
@@ -42,7 +43,7 @@ def main() -> None:
 
   arm, profile = robots.make(args.robot), profiles.get(args.profile)
   views = learners.views(arm, per_module=True)
-  windows, forwards = learned.trained_forward_models(arm, views, args.seed, profile)
+  windows, forwards = inverse_training.trained_forward_models(arm, views, args.seed, profile)
   params = hyperparameters.values("smpl", arm.name)
   settings = run.settings(args.task, "smpl", args.robot, seeds=1, profile=args.profile)
   for width, layers in args.columns:
@@ -53,7 +54,7 @@ def main() -> None:
 
     started = time.perf_counter()
     with mock.patch.object(progressive, "ProgressiveLSTM", Columns):
-      inverse, validation_loss = learned.train_inverse(
+      inverse, validation_loss = inverse_training.train_inverse(
         views, windows, forwards, args.seed, profile, True, None, params
       )
     trained_s = time.perf_counter() - started

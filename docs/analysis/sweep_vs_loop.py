@@ -41,9 +41,9 @@ from softbench import profiles
 from softbench import records
 from softbench import storage
 from softbench import zoo
-from softbench.agents import learned
 from softbench.data import dataset as babbling_dataset
 from softbench.leaderboard import grid
+from softbench.learning import inverse as inverse_training
 
 WAYS = ("loop", "sweep")
 PARTS = {  # The grid: the eight agents of its time (the reference came later).
@@ -103,7 +103,7 @@ def _timed(command: list[str], folder: pathlib.Path, what: str) -> int:
 
 def _dataset_folder(args: argparse.Namespace, home: pathlib.Path) -> pathlib.Path:
   config = babbling_dataset.generating_config(
-    args.robot, profiles.get(args.profile).samples, learned.DATA_SEED
+    args.robot, profiles.get(args.profile).samples, inverse_training.DATA_SEED
   )
   return babbling_dataset.dataset_folder(config, home)
 
@@ -114,7 +114,13 @@ def collect_dataset(args: argparse.Namespace) -> None:
   folder.mkdir(parents=True, exist_ok=True)
   samples = str(profiles.get(args.profile).samples)
   command = _command(
-    "collect", "--robot", args.robot, "--samples", samples, "--seed", str(learned.DATA_SEED)
+    "collect",
+    "--robot",
+    args.robot,
+    "--samples",
+    samples,
+    "--seed",
+    str(inverse_training.DATA_SEED),
   )
   if _timed(command, folder, "collect"):
     raise SystemExit("the collection failed; see its output above")

@@ -16,7 +16,7 @@ from smpl import training
 from softbench import agents
 from softbench import profiles
 from softbench import robots
-from softbench.agents import learned
+from softbench.learning import inverse as inverse_training
 from softbench.tuning import study
 
 
@@ -38,7 +38,7 @@ def main() -> None:
     views = learner.views(arm)
     for seed in range(args.seeds):
       agent = agents.make(name, arm.name, seed, profile.name)
-      (windows,), (forward,) = learned.trained_forward_models(arm, views, seed, profile)
+      (windows,), (forward,) = inverse_training.trained_forward_models(arm, views, seed, profile)
 
       def loss(batch, inverse=agent.inverse, forward=forward):
         return training.inverse_model_loss(inverse, forward, batch, include_aux_loss=False)

@@ -159,9 +159,11 @@ def make(
   seed: int = 0,
   profile: str | profiles.Profile = profiles.DEFAULT_PROFILE,
   show_progress: bool = False,
+  acting=None,
 ) -> Agent:
   """Agent ``name`` for ``robot``, built (and trained, if it learns) with ``seed`` and
-  ``profile``; ``show_progress`` shows training progress bars.
+  ``profile``; ``show_progress`` shows training progress bars. ``acting`` (``learned.Acting``;
+  None: its defaults) says how an agent trained on babbling acts; the other agents take none.
 
   Raises:
     ValueError: unknown agent, robot or profile, or a negative seed (one line).
@@ -173,7 +175,14 @@ def make(
   if entry.learner is not None:
     learned = importlib.import_module("softbench.agents.learned")
     return learned.build_agent(
-      name, arm, seed, profile, entry.learner.per_module, entry.learner.make_model, show_progress
+      name,
+      arm,
+      seed,
+      profile,
+      entry.learner.per_module,
+      entry.learner.make_model,
+      show_progress,
+      learned.Acting() if acting is None else acting,
     )
   build: Callable[..., Agent] = importlib.import_module(entry.module).build
   return build(arm, seed, profile, show_progress)

@@ -3,8 +3,8 @@
 ``retrain_column(agent, faulty_robot, seed, profile)`` takes the ``smpl`` agent trained on the
 healthy robot and a robot whose faults (``softbench.robots.faults``) all lie in one module M, and
 returns an agent whose column M is retrained on new motor babbling of the faulty robot (the
-profile's sample count, data seed ``learned.DATA_SEED``), with every other column's parameters
-bit-identical to the healthy agent's. What it retrains, and why:
+profile's sample count, data seed ``inverse_training.DATA_SEED``), with every other column's
+parameters bit-identical to the healthy agent's. What it retrains, and why:
 
 - Forward models of modules M..N (N the last module): they read module M's actuation, and the
   fault changes where that actuation takes module M's tip and every tip beyond it. The forward
@@ -42,6 +42,8 @@ from softbench import progress as progress_bars
 from softbench import storage
 from softbench.agents import hyperparameters
 from softbench.agents import learned
+from softbench.learning import checkpoints
+from softbench.learning import inverse as inverse_training
 from softbench.robots import base as robot_base
 
 ADAPTATION_VERSION = 1  # Bump when retraining changes, so cached retrained columns are not reused.
@@ -144,13 +146,10 @@ def retrain_column(
     faulty_robot.physics_sha256(),
     module,
     forward_modules,
-    profile.samples,
-    seed,
-    profile.max_epochs,
-    profile.patience,
-    profile.compile,
+    seed=seed,
+    **profile.training(),
   )
-  path = learned.checkpoint_file(config)
+  path = checkpoints.checkpoint_file(config)
   inverse = copy.deepcopy(agent.inverse)
   forwards = [copy.deepcopy(controller.forward).freeze() for controller in agent.controllers]
   bundle = torch.nn.ModuleDict(
@@ -169,7 +168,7 @@ def retrain_column(
   )
   if trained_now:
     dataset = data.collect(
-      faulty_robot, samples=profile.samples, seed=learned.DATA_SEED, progress=show_progress
+      faulty_robot, samples=profile.samples, seed=inverse_training.DATA_SEED, progress=show_progress
     )
     started = time.perf_counter()
     _retrain(agent, inverse, forwards, dataset, module, seed, profile, show_progress)
@@ -184,7 +183,7 @@ def retrain_column(
     for controller, forward in zip(agent.controllers, forwards)
   ]
   adapted = learned.LearnedAgent(
-    faulty_robot, seed, inverse, controllers, agent.error_source, agent.candidates
+    faulty_robot, seed, inverse, controllers, agent.acting, agent.candidates
   )
   return RetrainedColumn(adapted, module, forward_modules, wall_time, trained_now)
 
@@ -205,7 +204,7 @@ def _retrain(
     data.windows(dataset, controller.view, fitted=controller.normalisation)
     for controller in agent.controllers
   ]
-  forward_config, inverse_config = learned.training_configs(
+  forward_config, inverse_config = inverse_training.training_configs(
     seed, profile, hyperparameters.values("smpl", agent.robot.name)
   )
   device = training.default_device()

@@ -12,7 +12,7 @@ An agent on a robot without an entry of its own uses the default robot's values;
 without any trains with its model's and optimiser's defaults (a new baseline needs no entry).
 ``study`` is the summary of the Optuna study that chose the values (null: not chosen by a study).
 ``values`` reads the file, ``adopt`` writes a study's choice into it. Parameters named in
-``TRAINING_PARAMETERS`` go to the inverse model's optimiser
+``softbench.learning.inverse.TRAINING_PARAMETERS`` go to the inverse model's optimiser
 (``smpl.training.InverseTrainingConfig``), the others to the agent's model factory as keyword
 arguments (``smpl.baselines``). SMPL's width and depth stay at the paper's 2 LSTM layers of 32
 units per column (SPEC 5): only its optimisation is tuned.
@@ -27,7 +27,6 @@ from softbench import robots
 from softbench import storage
 
 PATH = pathlib.Path(__file__).with_name("hyperparameters.json")
-TRAINING_PARAMETERS = ("learning_rate", "batch_size", "weight_decay")
 
 
 def search_space(agent: str) -> Mapping:
@@ -95,16 +94,6 @@ def entry(agent: str, robot: str, path: pathlib.Path | None = None) -> dict:
 def values(agent: str, robot: str, path: pathlib.Path | None = None) -> dict:
   """The hyperparameters ``agent`` trains with on ``robot`` (module docstring)."""
   return dict(entry(agent, robot, path)["params"])
-
-
-def training_settings(params: dict) -> dict:
-  """The entries of ``params`` that configure the optimiser."""
-  return {name: value for name, value in params.items() if name in TRAINING_PARAMETERS}
-
-
-def model_settings(params: dict) -> dict:
-  """The entries of ``params`` that configure the model (keyword arguments of its factory)."""
-  return {name: value for name, value in params.items() if name not in TRAINING_PARAMETERS}
 
 
 def adopt(

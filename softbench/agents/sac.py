@@ -27,12 +27,13 @@ from smpl import snapshots
 from smpl import training
 from softbench import data
 from softbench import profiles
+from softbench import progress as progress_bars
 from softbench import storage
 from softbench.agents import base
-from softbench.agents import learned
-from softbench.data import progress as progress_bars
 from softbench.envs import environment
 from softbench.envs import streams
+from softbench.learning import checkpoints
+from softbench.learning import inverse as inverse_training
 from softbench.robots import base as robot_base
 
 EPISODE_STEPS = 50  # Control steps (targets) per training episode.
@@ -80,7 +81,7 @@ def policy_input(flat: np.ndarray, shapes: dict[str, tuple[int, ...]], length: f
 
 
 @dataclasses.dataclass(frozen=True)
-class TrainingConfig:
+class SacConfig:
   """Everything a trained model depends on; its hash names the checkpoint."""
 
   robot: str
@@ -99,10 +100,8 @@ class TrainingConfig:
     return storage.config_key(self, f"sac-{self.robot}-seed{self.seed}")
 
 
-def training_config(
-  robot: robot_base.SoftArm, seed: int, profile: profiles.Profile
-) -> TrainingConfig:
-  return TrainingConfig(
+def training_config(robot: robot_base.SoftArm, seed: int, profile: profiles.Profile) -> SacConfig:
+  return SacConfig(
     robot.name,
     robot.physics_sha256(),
     profile.samples,
@@ -120,7 +119,7 @@ def checkpoint_path(
 ) -> pathlib.Path:
   """Where the trained model of ``seed`` is cached (it exists once trained)."""
   key = training_config(robot, seed, profile).key
-  return storage.softbench_home() / learned.CHECKPOINT_FOLDER / f"{key}.pt"
+  return storage.softbench_home() / checkpoints.CHECKPOINT_FOLDER / f"{key}.pt"
 
 
 class _PolicyInput(vec_env.VecEnvWrapper):
@@ -148,7 +147,7 @@ def _training_env(
   robot: robot_base.SoftArm, seed: int, profile: profiles.Profile, first_episode: int
 ) -> tuple[vec_env.VecEnv, streams.TargetStreamEnv]:
   dataset = data.collect(
-    robot.name, samples=profile.samples, seed=learned.DATA_SEED, progress=False
+    robot.name, samples=profile.samples, seed=inverse_training.DATA_SEED, progress=False
   )
   stream_env = streams.TargetStreamEnv(
     robot, streams.training_targets(dataset, EPISODE_STEPS), EPISODE_STEPS, seed, first_episode
@@ -205,7 +204,7 @@ def _restore_random_states(model, states: dict) -> None:
   model.action_space.np_random.bit_generator.state = states["action_space"]
 
 
-def _read(path: pathlib.Path, config: TrainingConfig, kind: str) -> dict:
+def _read(path: pathlib.Path, config: SacConfig, kind: str) -> dict:
   """The saved dict at ``path``, checked to be of ``kind`` and made for ``config``."""
   saved = torch.load(path, map_location="cpu", weights_only=False)
   if (
@@ -220,7 +219,7 @@ def _read(path: pathlib.Path, config: TrainingConfig, kind: str) -> dict:
 
 def _save_state(
   path: pathlib.Path,
-  config: TrainingConfig,
+  config: SacConfig,
   model,
   stream_env,
   elapsed: float,

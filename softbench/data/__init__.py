@@ -15,7 +15,6 @@ from softbench.data.babbling import babbling_actions
 from softbench.data.babbling import collect
 from softbench.data.dataset import DEFAULT_SAMPLES
 from softbench.data.dataset import EPISODE_LENGTH
-from softbench.data.dataset import CorruptFileWarning
 from softbench.data.dataset import Dataset
 from softbench.data.dataset import DatasetError
 from softbench.data.dataset import dataset_folder
@@ -53,7 +52,6 @@ __all__ = [
   "FRACTIONS",
   "HELD_OUT_BABBLING_STREAM",
   "SPLITS",
-  "CorruptFileWarning",
   "Dataset",
   "DatasetError",
   "MinMaxNormaliser",

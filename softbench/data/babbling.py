@@ -18,11 +18,11 @@ import time
 
 import numpy as np
 
+from softbench import progress as progress_bars
 from softbench import robots
 from softbench import storage
 from softbench.data import chunks
 from softbench.data import dataset
-from softbench.data import progress as progress_bars
 from softbench.data import seeding
 from softbench.robots import recorder
 

@@ -64,9 +64,6 @@ class DatasetError(ValueError):
   """A dataset file is missing, unreadable, corrupt, or not the one its config asks for."""
 
 
-CorruptFileWarning = storage.CorruptFileWarning  # Where cache readers report damage.
-
-
 @dataclasses.dataclass(frozen=True, eq=False)
 class Dataset:
   """A verified babbling dataset (layout in the module docstring); arrays are read-only.

@@ -49,7 +49,7 @@ class DocTableError(ValueError):
 
 
 @dataclasses.dataclass(frozen=True)
-class Setting:
+class TableSetting:
   """What a column of records stands for: robot, profile and eval mode."""
 
   robot: str
@@ -60,10 +60,10 @@ class Setting:
     return f"{self.robot}, {self.profile} profile, eval {self.eval_mode}"
 
 
-def _entries(board: ranking.Leaderboard) -> dict[tuple[Setting, str, str], ranking.Entry]:
+def _entries(board: ranking.Leaderboard) -> dict[tuple[TableSetting, str, str], ranking.BoardEntry]:
   """The shown entry of each (setting, task, agent), plain tasks only."""
   return {
-    (Setting(group.robot, *entry.setting[1:]), group.task, entry.setting[0]): entry
+    (TableSetting(group.robot, *entry.setting[1:]), group.task, entry.setting[0]): entry
     for group, entry in ranking.plain_entries(board)
   }
 
@@ -80,7 +80,7 @@ def _with_paper(estimate, robot: str, task: str, agent: str) -> str:
   return text if paper is None else f"{text} ({paper:.2f})"
 
 
-def _over_seeds(entry: ranking.Entry, metric: str, module: int) -> metrics.Statistic:
+def _over_seeds(entry: ranking.BoardEntry, metric: str, module: int) -> metrics.Statistic:
   """Mean and std over seeds of one module's (0-based) episode error (``ranking.mean_and_std``
   formats it like an ``Estimate``: it reads only ``mean`` and ``std``)."""
   return metrics.Statistic.of(
@@ -88,7 +88,7 @@ def _over_seeds(entry: ranking.Entry, metric: str, module: int) -> metrics.Stati
   )
 
 
-def overview_table(setting: Setting) -> Callable[[ranking.Leaderboard], Table]:
+def overview_table(setting: TableSetting) -> Callable[[ranking.Leaderboard], Table]:
   """The leaderboard's overview of ``setting``: agents by tasks, the paper's mean in brackets."""
 
   def table(board: ranking.Leaderboard) -> Table:
@@ -104,7 +104,7 @@ def overview_table(setting: Setting) -> Callable[[ranking.Leaderboard], Table]:
   return table
 
 
-def modules_table(setting: Setting, task: str) -> Callable[[ranking.Leaderboard], Table]:
+def modules_table(setting: TableSetting, task: str) -> Callable[[ranking.Leaderboard], Table]:
   """Per-module position error of every agent on one task, ranked as the leaderboard ranks."""
 
   def table(board: ranking.Leaderboard) -> Table:
@@ -143,7 +143,9 @@ def modules_table(setting: Setting, task: str) -> Callable[[ranking.Leaderboard]
   return table
 
 
-def comparison_table(first: Setting, second: Setting) -> Callable[[ranking.Leaderboard], Table]:
+def comparison_table(
+  first: TableSetting, second: TableSetting
+) -> Callable[[ranking.Leaderboard], Table]:
   """Every agent's position error on ``first`` -> on ``second``, per task (``-``: no record)."""
 
   def table(board: ranking.Leaderboard) -> Table:
@@ -151,7 +153,7 @@ def comparison_table(first: Setting, second: Setting) -> Callable[[ranking.Leade
     shown = [(task, agent) for where, task, agent in found if where in (first, second)]
     columns = sorted({task for task, _ in shown}, key=suite.TASKS.index)
 
-    def cell(where: Setting, task: str, agent: str) -> str:
+    def cell(where: TableSetting, task: str, agent: str) -> str:
       entry = found.get((where, task, agent))
       if entry is None:
         return "-"
@@ -182,7 +184,7 @@ def eval_modes_table(
 
   def table(board: ranking.Leaderboard) -> Table:
     found = _entries(board)
-    settings = [Setting(robot, profile, mode) for mode in modes]
+    settings = [TableSetting(robot, profile, mode) for mode in modes]
     names = _agents_in(
       agent
       for where, on, agent in found
@@ -211,7 +213,7 @@ def eval_modes_table(
   return table
 
 
-def spiral_headline(settings: tuple[Setting, ...]) -> Callable[[ranking.Leaderboard], Table]:
+def spiral_headline(settings: tuple[TableSetting, ...]) -> Callable[[ranking.Leaderboard], Table]:
   """Every agent on the spiral of several settings, the paper's mean in brackets."""
 
   def table(board: ranking.Leaderboard) -> Table:
@@ -245,7 +247,7 @@ def spiral_headline(settings: tuple[Setting, ...]) -> Callable[[ranking.Leaderbo
   return table
 
 
-def _exp1s_entry(board: ranking.Leaderboard, family: str, profile: str) -> exp1s_board.Entry:
+def _exp1s_entry(board: ranking.Leaderboard, family: str, profile: str) -> exp1s_board.Exp1sEntry:
   """The shown SMPL Exp1S entry of ``family`` (e.g. ``tendon-local``) at ``profile``."""
   for group in board.exp1s:
     if not group.variant and group.robots[0].rsplit("-", 1)[0] == family:
@@ -263,14 +265,14 @@ def _exp1s_paper_mean(robot: str, loop: str, task: str) -> float | None:
 
 
 def _exp1s_figure(
-  entry: exp1s_board.Entry, loop: str, task: str, index: int, metric: str = METRIC
+  entry: exp1s_board.Exp1sEntry, loop: str, task: str, index: int, metric: str = METRIC
 ) -> str:
   """One configuration's (0-based) error, mean ± std over seeds, as the Exp1S section prints it."""
   statistic = entry.statistic(loop, task, index, metric)
   return exp1s_board.figure(statistic.mean, statistic.std)
 
 
-def _exp1s_cell(entry: exp1s_board.Entry, loop: str, task: str, index: int) -> str:
+def _exp1s_cell(entry: exp1s_board.Exp1sEntry, loop: str, task: str, index: int) -> str:
   paper = _exp1s_paper_mean(entry.record["robots"][index], loop, task)
   text = _exp1s_figure(entry, loop, task, index)
   return text if paper is None else f"{text} ({paper:.2f})"
@@ -366,12 +368,12 @@ def exp1s_headline(settings: tuple[tuple[str, str], ...]) -> Callable[[ranking.L
   return table
 
 
-TENDON_3 = Setting("tendon-3")
-LOCAL_3 = Setting("tendon-local-3")
-PNEUMATIC = Setting("pneumatic-433")
-TENDON_3_PAPER = Setting("tendon-3", "paper")
-LOCAL_3_PAPER = Setting("tendon-local-3", "paper")
-PNEUMATIC_PAPER = Setting("pneumatic-433", "paper")
+TENDON_3 = TableSetting("tendon-3")
+LOCAL_3 = TableSetting("tendon-local-3")
+PNEUMATIC = TableSetting("pneumatic-433")
+TENDON_3_PAPER = TableSetting("tendon-3", "paper")
+LOCAL_3_PAPER = TableSetting("tendon-local-3", "paper")
+PNEUMATIC_PAPER = TableSetting("pneumatic-433", "paper")
 
 TABLES: dict[str, Callable[[ranking.Leaderboard], Table]] = {
   "headline-spiral": spiral_headline(
@@ -553,7 +555,7 @@ __all__ = [
   "TABLES",
   "Block",
   "DocTableError",
-  "Setting",
+  "TableSetting",
   "blocks",
   "pages",
   "render",

@@ -50,7 +50,7 @@ def _figure(statistic: metrics.Statistic) -> str:
 
 
 @dataclasses.dataclass(frozen=True)
-class Entry:
+class Exp1sEntry:
   """One checked Exp1S record as the leaderboard shows it."""
 
   path: pathlib.Path
@@ -94,8 +94,8 @@ class Group:
 
   robots: tuple[str, ...]
   variant: str  # "" for a plain record; else its extra sections.
-  entries: tuple[Entry, ...]  # Newest per (agent, profile), by agent then profile.
-  superseded: tuple[Entry, ...]  # Older records of a shown setting, newest first.
+  entries: tuple[Exp1sEntry, ...]  # Newest per (agent, profile), by agent then profile.
+  superseded: tuple[Exp1sEntry, ...]  # Older records of a shown setting, newest first.
 
   @property
   def title(self) -> str:
@@ -109,11 +109,11 @@ class Group:
 
 def group(loaded: list[tuple[pathlib.Path, dict]]) -> tuple[Group, ...]:
   """The Exp1S groups of checked records (``records.read_folder``); other formats are ignored."""
-  by_group: dict[tuple[tuple[str, ...], str], list[Entry]] = {}
+  by_group: dict[tuple[tuple[str, ...], str], list[Exp1sEntry]] = {}
   for path, record in loaded:
     if record["format"] == exp1s_records.FORMAT:
       key = tuple(record["robots"]), ", ".join(f"with {name}" for name in records.sections(record))
-      by_group.setdefault(key, []).append(Entry(pathlib.Path(path), record))
+      by_group.setdefault(key, []).append(Exp1sEntry(pathlib.Path(path), record))
   groups = []
   for key in sorted(by_group, key=lambda k: (len(k[0]), k)):
     newest, superseded = selection.newest_per_setting(by_group[key])
@@ -130,7 +130,7 @@ def _paper_cells(robot: str, loop: str, task: str) -> list[str]:
   return [figure(*table["scores"][loop][task][metric][index]) for metric in PAPER_METRICS]
 
 
-def loop_table(entry: Entry, loop: str) -> Table:
+def loop_table(entry: Exp1sEntry, loop: str) -> Table:
   """The paper's Exp1S layout for one loop: per configuration our row, then the paper's."""
   tasks = entry.record["tasks"]
   header = (
@@ -158,7 +158,7 @@ def loop_table(entry: Entry, loop: str) -> Table:
   )
 
 
-def tip_table(entry: Entry) -> Table:
+def tip_table(entry: Exp1sEntry) -> Table:
   """Normalised tip error (%) per configuration, task and loop, mean ± std over seeds."""
   tasks = entry.record["tasks"]
   header = (
@@ -187,7 +187,7 @@ def tip_table(entry: Entry) -> Table:
   )
 
 
-def forgetting_table(entry: Entry) -> Table:
+def forgetting_table(entry: Exp1sEntry) -> Table:
   """The forgetting matrix as text: rows after each stage, columns per configuration."""
   robots = entry.record["robots"]
   rows = tuple(
@@ -204,17 +204,17 @@ def forgetting_table(entry: Entry) -> Table:
   )
 
 
-def score_tables(entry: Entry) -> tuple[Table, ...]:
+def score_tables(entry: Exp1sEntry) -> tuple[Table, ...]:
   """The error tables of one entry: per loop, then the normalised tip error."""
   return (*(loop_table(entry, loop) for loop in exp1s_records.LOOPS), tip_table(entry))
 
 
-def tables(entry: Entry) -> tuple[Table, ...]:
+def tables(entry: Exp1sEntry) -> tuple[Table, ...]:
   """Every table of one entry, in page order: the error tables, then the forgetting matrix."""
   return (*score_tables(entry), forgetting_table(entry))
 
 
-def describe(entry: Entry) -> str:
+def describe(entry: Exp1sEntry) -> str:
   """One line on what the entry is: agent, profile, seeds and date."""
   return (
     f"{entry.label}, {entry.record['seeds']} seed(s), {entry.record['date']}, end "

@@ -116,7 +116,7 @@ def _task_boards(
   """``group``'s rows split by profile and eval mode, each ranked, with a chart per metric and
   each record's verification (``board.is_verified``); ``prefix`` begins each board's anchor (an
   earlier physics version's section)."""
-  by_setting: dict[tuple[str, str], list[ranking.Entry]] = {}
+  by_setting: dict[tuple[str, str], list[ranking.BoardEntry]] = {}
   for entry in group.entries:  # Already ranked.
     by_setting.setdefault(entry.setting[1:], []).append(entry)
   videos = any(links.video(entry, out) for entry in group.entries)
@@ -291,7 +291,7 @@ def _rgb(colour: Iterable[float]) -> str:
   return "#" + "".join(f"{round(channel):02x}" for channel in colour)
 
 
-def _heat_map(entry: exp1s_board.Entry) -> dict:
+def _heat_map(entry: exp1s_board.Exp1sEntry) -> dict:
   """The forgetting matrix with each cell's colour (light 0, dark the largest value)."""
   table = exp1s_board.forgetting_table(entry)
   values = entry.forgetting()

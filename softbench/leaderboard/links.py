@@ -18,12 +18,12 @@ def relative(target: pathlib.Path, out: pathlib.Path) -> str:
   return pathlib.Path(os.path.relpath(target.resolve(), out.resolve())).as_posix()
 
 
-def record(entry: ranking.Entry, out: pathlib.Path) -> str:
+def record(entry: ranking.BoardEntry, out: pathlib.Path) -> str:
   """The record file of ``entry``, from the folder ``out``."""
   return relative(entry.path, out)
 
 
-def video(entry: ranking.Entry, out: pathlib.Path) -> str | None:
+def video(entry: ranking.BoardEntry, out: pathlib.Path) -> str | None:
   """The video of ``entry`` from the folder ``out``, or ``None`` if the record has none."""
   location = entry.record.get("video")
   if location is None:

@@ -92,7 +92,7 @@ COMPLETED_NOTE = f"{COMPLETED_MARK}: the agent completed the partial target (tar
 
 
 @dataclasses.dataclass(frozen=True)
-class Entry:
+class BoardEntry:
   """One record as the leaderboard shows it."""
 
   path: pathlib.Path
@@ -100,7 +100,7 @@ class Entry:
   estimates: dict[str, Estimate]  # By metric name, for the metrics the record holds.
 
   @classmethod
-  def of(cls, path: pathlib.Path, record: dict) -> "Entry":
+  def of(cls, path: pathlib.Path, record: dict) -> "BoardEntry":
     measured = [name for name in records.METRICS if name in record["per_seed"][0]]
     return cls(
       pathlib.Path(path),
@@ -153,8 +153,8 @@ class Group:
   robot: str
   task: str
   variant: str  # "" for the plain task; else the trajectory and/or the extra sections.
-  entries: tuple[Entry, ...]  # Ranked, best first.
-  superseded: tuple[Entry, ...]  # Older records of a shown setting, newest first.
+  entries: tuple[BoardEntry, ...]  # Ranked, best first.
+  superseded: tuple[BoardEntry, ...]  # Older records of a shown setting, newest first.
 
   @property
   def title(self) -> str:
@@ -183,7 +183,7 @@ class Leaderboard:
   earlier: tuple["Leaderboard", ...] = ()  # The records of earlier physics versions, oldest first.
   verified: frozenset[str] = frozenset()  # File names of the records the zoo re-scored (verified).
 
-  def is_verified(self, entry: "Entry") -> bool:
+  def is_verified(self, entry: "BoardEntry") -> bool:
     """Whether ``entry``'s record is in the verification ledger as it is now
     (``softbench.leaderboard.verified``)."""
     return entry.path.name in self.verified
@@ -232,7 +232,7 @@ def setting_order(robot: str, profile: str, eval_mode: str) -> tuple:
   )
 
 
-def plain_entries(board: "Leaderboard") -> Iterator[tuple[Group, Entry]]:
+def plain_entries(board: "Leaderboard") -> Iterator[tuple[Group, BoardEntry]]:
   """Every shown row of a plain task (no trajectory or extra section), with its group."""
   for group in board.groups:
     if not group.variant:
@@ -267,12 +267,12 @@ def rank(
 
 def _rank_one(loaded: list[tuple[pathlib.Path, dict]], physics: str) -> Leaderboard:
   """The leaderboard of checked records of one physics version."""
-  by_group: dict[tuple[str, str, str], list[Entry]] = {}
+  by_group: dict[tuple[str, str, str], list[BoardEntry]] = {}
   for path, record in loaded:
     # Adaptive activation records hold per-target results, no per-seed ones
     # (softbench.runners.adaptive).
     if record["format"] == records.FORMAT and record["per_seed"]:
-      by_group.setdefault(_group_key(record), []).append(Entry.of(path, record))
+      by_group.setdefault(_group_key(record), []).append(BoardEntry.of(path, record))
   groups = []
   for key in sorted(by_group, key=lambda k: (robot_order(k[0]), suite.TASKS.index(k[1]), k[2])):
     shown, superseded = selection.newest_per_setting(by_group[key])
@@ -298,7 +298,7 @@ def _rank_one(loaded: list[tuple[pathlib.Path, dict]], physics: str) -> Leaderbo
 ORACLE_PLACE = "oracle"  # The place column of an oracle's row (agents.is_oracle): not ranked.
 
 
-def places(entries: tuple[Entry, ...]) -> list[str]:
+def places(entries: tuple[BoardEntry, ...]) -> list[str]:
   """The place of each of a group's ranked ``entries``: 1, 2, ... and ``ORACLE_PLACE`` for an
   oracle, which ranks after every other agent and takes no place."""
   shown, place = [], 0

@@ -22,6 +22,7 @@ from softbench import data
 from softbench import progress as progress_bars
 from softbench import storage
 from softbench import zoo
+from softbench.learning import checkpoints
 from softbench.learning import protocols
 from softbench.robots import base as robot_base
 
@@ -98,7 +99,7 @@ def prepare(
   windows, forwards = [], []
   for view, key in zip(views, configs(robot, views, samples, data_seed, config, training_version)):
     path = cache_file(key)
-    partial = path.with_suffix(".partial")  # Its training snapshots until it is saved.
+    partial = checkpoints.snapshot_folder(path)  # Its training snapshots until it is saved.
     zoo.restore(path)
 
     def train() -> tuple[data.SplitWindows, smpl_forward.ForwardModel]:

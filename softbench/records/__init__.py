@@ -110,7 +110,7 @@ def schema() -> dict:
     "eval_mode": {"enum": list(record_fields.ERROR_SOURCES)},
     "trajectory": {"type": ["string", "null"]},
     "given": {"type": "string", "minLength": 1},  # A custom trajectory's given part (Given.text).
-    # How a learned agent completed partial targets (softbench.agents.learned.HELPER_TARGETS);
+    # How a learned agent completed partial targets (softbench.agents.fields.HELPER_TARGETS);
     # records before target completion (2026-12-03) held every module not given ("hold").
     "helpers": {"enum": list(record_fields.HELPER_TARGETS)},
     "scored_modules": {

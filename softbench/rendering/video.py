@@ -16,7 +16,6 @@ import sys
 import tempfile
 import time
 
-import numpy as np
 from rich.progress import Progress
 
 from softbench import progress as progress_bars
@@ -172,13 +171,3 @@ def render(
     f"no OpenGL backend can render off-screen here ({tried}); install "
     f"{install}, or set MUJOCO_GL to a backend that works"
   )
-
-
-def render_frames(
-  replay: episode_replay.Replay, options: video_options.VideoOptions = video_options.VideoOptions()
-) -> np.ndarray:
-  """(frames, height, width, 3) uint8: every frame of ``replay``, as ``render`` draws them."""
-  with tempfile.TemporaryDirectory(prefix="softbench-frames-") as folder:
-    path = pathlib.Path(folder) / "frames.npy"
-    render(replay, path, options)
-    return np.load(path)

@@ -26,22 +26,20 @@ import time
 import numpy as np
 
 from smpl import progressive
-from smpl import protocol as smpl_protocol
 from smpl import training
 from softbench import data
 from softbench import episodes
 from softbench import metrics
 from softbench import profiles
-from softbench import progress as progress_bars
 from softbench import robots
-from softbench import storage
 from softbench import suite
 from softbench import zoo
 from softbench.agents import hyperparameters
 from softbench.agents import learned
 from softbench.data import dataset
 from softbench.episodes import snapshots as episode_snapshots
-from softbench.learning import protocols
+from softbench.learning import exp1s as exp1s_training
+from softbench.learning import inverse as inverse_training
 from softbench.records import provenance
 from softbench.records.exp1s import DEFAULT_FAMILY
 from softbench.records.exp1s import FORGETTING_TASK
@@ -55,18 +53,8 @@ from softbench.runners import evaluation
 from softbench.runners import parallel_seeds
 
 
-def protocol(family: str = DEFAULT_FAMILY) -> protocols.Protocol:
-  """Exp1S on the arms of tendon family ``family``; raises a one-line ValueError for an unknown
-  family."""
-  if family not in robots.TENDON_FAMILIES:
-    raise ValueError(
-      f"unknown tendon family {family!r}; choose one of {', '.join(robots.TENDON_FAMILIES)}"
-    )
-  return protocols.get(PROTOCOL).on_family(family)
-
-
 @dataclasses.dataclass(frozen=True)
-class RunSettings:
+class Exp1sSettings:
   """A checked Exp1S run (``softbench run --protocol exp1s``)."""
 
   profile: profiles.Profile
@@ -82,7 +70,7 @@ def settings(
   seeds: int | None = None,
   eval_mode: str = "physics",
   task_options: Sequence[str] = (),
-) -> RunSettings:
+) -> Exp1sSettings:
   """Checked settings of ``softbench run --protocol``, its seeds resolved (None: the profile's):
   Exp1S fixes its robots, tasks and loops, so it takes agent smpl, the physics eval mode and none
   of a task run's options (``task_options``: the flags given, e.g. ``--task``).
@@ -109,8 +97,8 @@ def settings(
     )
   chosen = profiles.get(profile)
   family = family or DEFAULT_FAMILY
-  protocol(family)
-  return RunSettings(chosen, family, seed_count(chosen, seeds))
+  exp1s_training.protocol(family)
+  return Exp1sSettings(chosen, family, seed_count(chosen, seeds))
 
 
 def seed_count(profile: profiles.Profile, seeds: int | None) -> int:
@@ -124,26 +112,6 @@ def seed_count(profile: profiles.Profile, seeds: int | None) -> int:
   return seeds
 
 
-@dataclasses.dataclass(frozen=True)
-class Exp1sConfig:
-  """Everything the sequentially trained network depends on; its hash names the checkpoint."""
-
-  robots: tuple[str, ...]
-  robot_xml_sha256: tuple[str, ...]
-  samples: int
-  seed: int
-  max_epochs: int
-  patience: int
-  compile: bool
-  # SMPL's hyperparameters (softbench.agents.hyperparameters).
-  params: tuple[tuple[str, object], ...]
-  training_version: int = learned.TRAINING_VERSION
-
-  @property
-  def key(self) -> str:
-    return storage.config_key(self, f"{PROTOCOL}-seed{self.seed}")
-
-
 @dataclasses.dataclass(frozen=True, eq=False)
 class Exp1sModel:
   """The trained network, each configuration's controller, and the model-level forgetting
@@ -155,105 +123,43 @@ class Exp1sModel:
   forgetting_pose_mse: np.ndarray
   forgetting_action_mse: np.ndarray
 
-  def agent(self, configuration: int, seed: int) -> learned.LearnedAgent:
+  def agent(
+    self, configuration: int, seed: int, acting: learned.Acting = learned.Acting()
+  ) -> learned.LearnedAgent:
     """The controller of configuration ``configuration`` (1 = the one-module arm): its column
-    alone."""
+    alone, acting as ``acting``."""
     index = configuration - 1
     column = progressive.ProgressiveColumn(self.network, index)
-    return learned.LearnedAgent(self.arms[index], seed, column, [self.controllers[index]])
+    return learned.LearnedAgent(self.arms[index], seed, column, [self.controllers[index]], acting)
 
 
-def _config(seed: int, profile: profiles.Profile, arms: list) -> Exp1sConfig:
-  return Exp1sConfig(
-    tuple(arm.name for arm in arms),
-    tuple(arm.physics_sha256() for arm in arms),
-    profile.samples,
-    seed,
-    profile.max_epochs,
-    profile.patience,
-    profile.compile,
-    tuple(sorted(_params(arms[-1].name).items())),
-  )
-
-
-def _params(last_robot: str) -> dict:
-  """SMPL's hyperparameters for the sequence ending with ``last_robot`` (the agent's, tuned on
+def _params(family: str) -> dict:
+  """SMPL's hyperparameters for ``family``'s sequence, by its last robot (the agent's, tuned on
   tendon-3 unless that robot has its own; the columns keep the SPEC's size)."""
-  return hyperparameters.values("smpl", last_robot)
-
-
-def _train(seed: int, profile: profiles.Profile, show: bool, family: str):
-  """Column by column over the configurations; returns network, forwards, normalisations, run."""
-  sequence = protocol(family)
-  forward_config, inverse_config = learned.training_configs(
-    seed, profile, _params(sequence.robot_names[-1])
-  )
-  epoch_bars = lambda label: progress_bars.epochs(
-    f"{label} ({PROTOCOL} seed {seed})", profile.max_epochs, show
-  )
-  result = protocols.run(
-    sequence,
-    profile.samples,
-    learned.DATA_SEED,
-    forward_config,
-    inverse_config,
-    training.default_device(),
-    show,
-    epoch_bars,
-  )
-  result.network.requires_grad_(False)
-  return (
-    result.network,
-    [column.forward_model for column in result.columns],
-    [column.windows.normalisation for column in result.columns],
-    result.run,
-  )
-
-
-def _matrices(outcome: smpl_protocol.ProgressiveRun) -> dict[str, np.ndarray]:
-  return {
-    f"forgetting/{metric}": outcome.forgetting_matrix(metric).numpy()
-    for metric in ("pose_mse", "action_mse")
-  }
+  return hyperparameters.values("smpl", exp1s_training.protocol(family).robot_names[-1])
 
 
 def checkpoint_path(
   seed: int, profile: profiles.Profile, family: str = DEFAULT_FAMILY
 ) -> pathlib.Path:
   """Where ``build`` caches the Exp1S network of ``seed`` (it exists once trained)."""
-  arms = [arm for arm, _ in protocol(family).column_views()]
-  return learned.checkpoint_file(_config(seed, profile, arms))
+  return exp1s_training.checkpoint_path(seed, profile, _params(family), family)
 
 
 def build(
   seed: int, profile: profiles.Profile, show_progress: bool = False, family: str = DEFAULT_FAMILY
 ) -> Exp1sModel:
-  """The Exp1S network of ``seed``: from the checkpoint cache, or trained now and cached."""
-  views_of = protocol(family).column_views()
-  arms = [arm for arm, _ in views_of]
-  views = [view for _, view in views_of]
-  config = _config(seed, profile, arms)
-
-  def train() -> learned.TrainedModels:
-    network, forwards, normalisations, outcome = _train(seed, profile, show_progress, family)
-    return learned.TrainedModels(network, forwards, normalisations, _matrices(outcome))
-
-  models = learned.load_or_train(
-    learned.checkpoint_file(config),
-    config,
-    [arm.name for arm in arms],
-    lambda: learned.untrained(views, True, None, _params(arms[-1].name)),
-    train,
+  """The Exp1S network of ``seed`` and its controllers: from the checkpoint cache, or trained now
+  and cached (``learning.exp1s``)."""
+  models, arms, views = exp1s_training.load_or_train(
+    seed, profile, _params(family), show_progress, family
   )
-  network, forwards, normalisations = models.inverse, models.forwards, models.normalisations
-  matrices = models.arrays
-  network.eval()
   return Exp1sModel(
-    network,
-    learned.controllers(views, forwards, normalisations),
+    models.inverse,
+    learned.controllers(views, models.forwards, models.normalisations),
     arms,
-    matrices["forgetting/pose_mse"],
-    matrices["forgetting/action_mse"],
+    models.arrays["forgetting/pose_mse"],
+    models.arrays["forgetting/action_mse"],
   )
 
 
@@ -285,7 +191,7 @@ def finished_seeds_folder(profile: profiles.Profile, family: str = DEFAULT_FAMIL
   """Where the scores of the seeds (and, under ``EPISODES_FOLDER``, of the episodes) that an
   interrupted run finished are kept (``episode_snapshots``: keyed by the settings and the code)."""
   return episode_snapshots.keyed_folder(
-    f"smpl-{PROTOCOL}", (dataclasses.asdict(profile), protocol(family).robot_names)
+    f"smpl-{PROTOCOL}", (dataclasses.asdict(profile), exp1s_training.protocol(family).robot_names)
   )
 
 
@@ -298,33 +204,33 @@ def run_seed(
   """``score_seed``, or the scores an interrupted run of the same settings and code kept: the
   seed's, or those of each episode it had finished."""
   folder = finished_seeds_folder(profile, family)
-  scores = kept_scores(RunSettings(profile, family), seed)
+  scores = kept_scores(Exp1sSettings(profile, family), seed)
   if scores is None:
     episodes = folder / EPISODES_FOLDER
     kept = len(list(episodes.glob(f"seed{seed}-*.json")))
     if kept and show_progress:
-      total = len(protocol(family).robot_names) * len(LOOPS) * len(TASKS)
+      total = len(exp1s_training.protocol(family).robot_names) * len(LOOPS) * len(TASKS)
       print(
         f"resuming seed {seed}: {kept} of its {total} episodes finished before the run was "
         "interrupted",
         file=sys.stderr,
       )
     scores = score_seed(seed, profile, show_progress, episodes, family)
-    keep_scores(RunSettings(profile, family), seed, scores)
+    keep_scores(Exp1sSettings(profile, family), seed, scores)
   return scores
 
 
-def _kept_seed_file(run: RunSettings, seed: int) -> tuple[pathlib.Path, str]:
+def _kept_seed_file(run: Exp1sSettings, seed: int) -> tuple[pathlib.Path, str]:
   return finished_seeds_folder(run.profile, run.family) / f"seed{seed}.json", f"seed {seed}"
 
 
-def kept_scores(run: RunSettings, seed: int) -> dict | None:
+def kept_scores(run: Exp1sSettings, seed: int) -> dict | None:
   """The scores of ``seed`` that an interrupted run of ``run``'s settings and code kept; None
   if there are none (or they are damaged: reported on one line)."""
   return episode_snapshots.load_scores(*_kept_seed_file(run, seed))
 
 
-def keep_scores(run: RunSettings, seed: int, scores: dict) -> None:
+def keep_scores(run: Exp1sSettings, seed: int, scores: dict) -> None:
   """Keeps the scores of ``seed`` until the record of ``run`` is written (``finish``)."""
   path, subject = _kept_seed_file(run, seed)
   episode_snapshots.save_scores(path, scores, subject)
@@ -351,9 +257,8 @@ def score_seed(
   check_no_forgetting(model.forgetting_action_mse)
   scores = {loop: {task: [] for task in TASKS} for loop in LOOPS}
   for configuration, arm in enumerate(model.arms, start=1):
-    agent = model.agent(configuration, seed)
     for loop, error_source in LOOPS.items():
-      agent.error_source = error_source
+      agent = model.agent(configuration, seed, learned.Acting(error_source))
       for task in TASKS:
         name = f"seed{seed}-configuration{configuration}-{loop}-{task}"
         subject = f"seed {seed}'s {loop}-loop {task} episode of configuration {configuration}"
@@ -397,12 +302,14 @@ def execute(
   discards them, ``episode_snapshots.discard_folder(finished_seeds_folder(profile, family))``,
   once the record is safely written)."""
   started = time.perf_counter()
-  origin = provenance.provenance(str(learned.training.default_device()))
+  origin = provenance.provenance(str(training.default_device()))
   seeds = seed_count(profile, seeds)
-  sequence = protocol(family)
+  sequence = exp1s_training.protocol(family)
   taken, trained = zoo.take([checkpoint_path(seed, profile, family) for seed in range(seeds)])
   for arm, _ in [] if trained else sequence.column_views():  # Every core, before the seeds.
-    data.collect(arm, samples=profile.samples, seed=learned.DATA_SEED, progress=show_progress)
+    data.collect(
+      arm, samples=profile.samples, seed=inverse_training.DATA_SEED, progress=show_progress
+    )
   if show_progress:
     episode_snapshots.report_resuming(finished_seeds_folder(profile, family), seeds)
   per_seed = parallel_seeds.over_seeds(
@@ -411,12 +318,12 @@ def execute(
   if not keep_seeds:
     episode_snapshots.discard_folder(finished_seeds_folder(profile, family))
   return assemble_record(
-    RunSettings(profile, family, seeds), origin, per_seed, taken, time.perf_counter() - started
+    Exp1sSettings(profile, family, seeds), origin, per_seed, taken, time.perf_counter() - started
   )
 
 
 def assemble_record(
-  run: RunSettings, origin: dict, per_seed: list[dict], taken: list[str], wall_time_s: float
+  run: Exp1sSettings, origin: dict, per_seed: list[dict], taken: list[str], wall_time_s: float
 ) -> dict:
   """The Exp1S record of ``run`` (its ``seeds`` given): provenance ``origin``
   (``records.provenance``), every seed's scores (``score_seed``, seed order), the zoo files
@@ -428,7 +335,7 @@ def assemble_record(
     **origin,
     "protocol": PROTOCOL,
     "agent": "smpl",
-    "robots": list(protocol(run.family).robot_names),
+    "robots": list(exp1s_training.protocol(run.family).robot_names),
     "tasks": list(TASKS),
     "profile": run.profile.name,
     "profile_settings": dataclasses.asdict(run.profile),

@@ -20,6 +20,7 @@ import dataclasses
 import pathlib
 import time
 
+from smpl import training
 from softbench import agents
 from softbench import data
 from softbench import metrics
@@ -27,6 +28,7 @@ from softbench import profiles
 from softbench import robots
 from softbench.agents import adaptation
 from softbench.agents import learned
+from softbench.learning import inverse as inverse_training
 from softbench.records import provenance
 from softbench.robots import faults as fault_model
 from softbench.runners import run as run_module
@@ -92,7 +94,8 @@ def _timed_baseline(
   path = learned.checkpoint_path(settings.baseline, faulty, seed, profile, per_module=False)
   cached = _file_identity(path)
   started = time.perf_counter()
-  agent = agents.make(settings.baseline, faulty, seed, profile, show_progress)
+  acting = run_module.acting(settings.run)
+  agent = agents.make(settings.baseline, faulty, seed, profile, show_progress, acting)
   trained_now = _file_identity(path) != cached
   if trained_now:
     adaptation.write_wall_time(path, round(time.perf_counter() - started, 3))
@@ -114,7 +117,9 @@ def _seed(settings: RetrainSettings, seed: int, show_progress: bool) -> dict:
   run = settings.run
   healthy = robots.make(run.robot)
   faulty = healthy.with_faults(run.faults)
-  smpl = agents.make(RETRAINED_AGENT, healthy, seed, run.profile, show_progress)
+  smpl = agents.make(
+    RETRAINED_AGENT, healthy, seed, run.profile, show_progress, run_module.acting(run)
+  )
   before, scored = run_module.evaluate(smpl, healthy, run, seed, show_progress)
   under, _ = run_module.evaluate(smpl, faulty, run, seed, show_progress)
   retrained = adaptation.retrain_column(smpl, faulty, run.profile, show_progress)
@@ -139,13 +144,15 @@ def execute(settings: RetrainSettings, show_progress: bool = True) -> dict:
   """Collects both robots' babbling, runs every seed (one after the other) and returns the
   result record."""
   started = time.perf_counter()
-  origin = provenance.provenance(str(learned.training.default_device()))
+  origin = provenance.provenance(str(training.default_device()))
   run = settings.run
   healthy = robots.make(run.robot)
   faulty = healthy.with_faults(run.faults)
-  data.collect(healthy, samples=run.profile.samples, seed=learned.DATA_SEED, progress=show_progress)
+  data.collect(
+    healthy, samples=run.profile.samples, seed=inverse_training.DATA_SEED, progress=show_progress
+  )
   faulty_data = data.collect(
-    faulty, samples=run.profile.samples, seed=learned.DATA_SEED, progress=show_progress
+    faulty, samples=run.profile.samples, seed=inverse_training.DATA_SEED, progress=show_progress
   )
   seeds = [_seed(settings, seed, show_progress) for seed in range(run.seeds)]
   module = settings.module

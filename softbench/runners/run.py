@@ -17,6 +17,7 @@ import dataclasses
 import pathlib
 import time
 
+from smpl import training
 from softbench import agents
 from softbench import data
 from softbench import episodes
@@ -29,6 +30,8 @@ from softbench import zoo
 from softbench.agents import learned
 from softbench.data import dataset
 from softbench.episodes import snapshots as episode_snapshots
+from softbench.learning import inverse as inverse_training
+from softbench.records import fields
 from softbench.records import provenance
 from softbench.rendering import options as video_options
 from softbench.rendering import replay
@@ -110,9 +113,9 @@ def settings(
     raise ValueError("--fault and --adaptive do not go together yet")
   seeds = (1 if adaptive else chosen.seeds) if seeds is None else seeds
   dataset.check_count("seeds", seeds, profiles.MAX_SEEDS)
-  if eval_mode not in learned.ERROR_SOURCES:
+  if eval_mode not in fields.ERROR_SOURCES:
     raise ValueError(
-      f"unknown eval mode {eval_mode!r}; choose one of {', '.join(learned.ERROR_SOURCES)}"
+      f"unknown eval mode {eval_mode!r}; choose one of {', '.join(fields.ERROR_SOURCES)}"
     )
   if (trajectory is None) == (task == "custom"):
     raise ValueError("--trajectory goes with --task custom, and --task custom needs one")
@@ -193,6 +196,11 @@ def _helpers(run: RunSettings, helpers: str | None) -> str | None:
       )
     return None
   return learned.DEFAULT_HELPER_TARGETS if helpers is None else helpers
+
+
+def acting(run: RunSettings) -> learned.Acting:
+  """How ``run``'s agent acts, if it is trained on babbling: its eval mode and helper targets."""
+  return learned.Acting(run.eval_mode, run.helpers or learned.DEFAULT_HELPER_TARGETS)
 
 
 def task_options(run: RunSettings) -> dict:
@@ -287,10 +295,8 @@ def episode_on(
 ) -> episodes.Episode:
   """One episode of ``run``'s task (environment seed ``seed``) by ``agent`` on ``arm``, which may
   be a faulty robot; kept while it runs at ``unfinished`` (``evaluation.run_episode``)."""
-  if isinstance(agent, learned.LearnedAgent):
-    agent.error_source = run.eval_mode
-    if run.helpers is not None:
-      agent.helper_targets = run.helpers
+  if isinstance(agent, learned.LearnedAgent) and agent.acting != acting(run):
+    raise ValueError(f"this agent acts as {agent.acting}, but the run asks for {acting(run)}")
   env = suite.load(arm, run.task, seed=seed, **task_options(run))
   return evaluation.run_episode(env, agent, run.task, show_progress, unfinished)
 
@@ -324,7 +330,7 @@ def _episode_and_arm(
 ) -> tuple[episodes.Episode, robots.SoftArm]:
   """``seed_episode``, and the (faulty) robot it ran on."""
   arm = robots.make(run.robot)
-  agent = agents.make(run.agent, arm, seed, run.profile, show_progress)
+  agent = agents.make(run.agent, arm, seed, run.profile, show_progress, acting(run))
   faulty = arm.with_faults(run.faults)
   return episode_on(agent, faulty, run, seed, show_progress, unfinished), faulty
 
@@ -415,12 +421,15 @@ def execute_episodes(
   kept for resuming are discarded at the end unless ``keep_seeds``: then the caller discards
   them (``episode_snapshots.discard``) once the record is safely written."""
   started = time.perf_counter()
-  origin = provenance.provenance(str(learned.training.default_device()))
+  origin = provenance.provenance(str(training.default_device()))
   taken, trained = take_from_zoo(run)
   learns = agents.learner(run.agent) is not None or agents.describe(run.agent).learned
   if learns and not trained:  # Some seed trains on babbling (or acts towards its targets, sac).
     data.collect(
-      run.robot, samples=run.profile.samples, seed=learned.DATA_SEED, progress=show_progress
+      run.robot,
+      samples=run.profile.samples,
+      seed=inverse_training.DATA_SEED,
+      progress=show_progress,
     )
   if run.adaptive:
     section = adaptive_runner.run(

@@ -14,13 +14,14 @@ from softbench import storage
 from softbench import zoo
 from softbench.agents import learned
 from softbench.data import seeding
+from softbench.learning import exp1s as exp1s_training
 from softbench.records import fields as record_fields
 from softbench.robots import versions
 from softbench.runners import continual
 
 
 @dataclasses.dataclass(frozen=True)
-class Setting:
+class CachedSetting:
   """A learned agent on a robot (``agent`` and ``robot``), or Exp1S on a tendon family
   (``family``), at a profile, for the seeds ``seeds`` (ascending)."""
 
@@ -46,8 +47,8 @@ def setting(
   profile: str,
   seeds: int | None,
   only_seeds: Sequence[int] = (),
-) -> Setting:
-  """A checked ``Setting``: ``agent`` (learned) with ``robot``, or ``family`` alone, for seeds
+) -> CachedSetting:
+  """A checked ``CachedSetting``: ``agent`` (learned) with ``robot``, or ``family`` alone, for seeds
   0 .. ``seeds``-1 (default: the profile's), or for the seeds ``only_seeds`` alone.
 
   Raises:
@@ -62,8 +63,8 @@ def setting(
       raise ValueError(
         f"--protocol {continual.PROTOCOL} trains smpl on its family's arms; drop --robot"
       )
-    continual.protocol(family)
-    return Setting(chosen, seeds, family=family)
+    exp1s_training.protocol(family)
+    return CachedSetting(chosen, seeds, family=family)
   if agent is None or robot is None:
     raise ValueError(
       "name the setting: --agent AGENT --robot ROBOT, or --protocol "
@@ -75,7 +76,7 @@ def setting(
       f"({', '.join(agents.babbling_learners())}), not of {agent!r}"
     )
   robots.make(robot)
-  return Setting(chosen, seeds, agent=agent, robot=robot)
+  return CachedSetting(chosen, seeds, agent=agent, robot=robot)
 
 
 def chosen_seeds(
@@ -105,7 +106,7 @@ def requested_setting(
   profile: str,
   seeds: int | None,
   only_seeds: Sequence[int] = (),
-) -> Setting:
+) -> CachedSetting:
   """The ``setting`` that ``softbench zoo add`` names: ``agent`` on ``robot``, or ``protocol``
   (Exp1S) on ``family`` (default ``continual.DEFAULT_FAMILY``).
 
@@ -122,7 +123,7 @@ def requested_setting(
   return setting(agent, robot, family, profile, seeds, only_seeds)
 
 
-def cache_files(chosen: Setting) -> list[tuple[int, pathlib.Path, str]]:
+def cache_files(chosen: CachedSetting) -> list[tuple[int, pathlib.Path, str]]:
   """(seed, cache file, zoo kind) of every file the setting's training writes to the data
   home: each seed's checkpoint, then (for an agent) its forward models."""
   if chosen.family is not None:
@@ -140,7 +141,7 @@ def cache_files(chosen: Setting) -> list[tuple[int, pathlib.Path, str]]:
   ]
 
 
-def stands_behind(record: dict, chosen: Setting, seed: int) -> bool:
+def stands_behind(record: dict, chosen: CachedSetting, seed: int) -> bool:
   """Whether ``record`` is one of ``chosen``'s with a seed ``seed`` (healthy robot), simulated
   with the installed physics version (the cache files' own)."""
   if record["profile"] != chosen.profile.name or seed >= record["seeds"]:
@@ -150,7 +151,7 @@ def stands_behind(record: dict, chosen: Setting, seed: int) -> bool:
   if chosen.family is not None:
     return (
       record["format"] == continual.RECORD_FORMAT
-      and tuple(record["robots"]) == continual.protocol(chosen.family).robot_names
+      and tuple(record["robots"]) == exp1s_training.protocol(chosen.family).robot_names
     )
   return (
     record["format"] == records.FORMAT
@@ -183,7 +184,7 @@ class Links:
   unchecked: list[str]
 
 
-def records_of(chosen: Setting, results: pathlib.Path, link_unchecked: bool = False) -> Links:
+def records_of(chosen: CachedSetting, results: pathlib.Path, link_unchecked: bool = False) -> Links:
   """The records in ``results`` that each seed's weights in the data home made; a record that
   names no weights is linked only with ``link_unchecked``."""
   found = records.read_folder(results)
@@ -206,8 +207,11 @@ def records_of(chosen: Setting, results: pathlib.Path, link_unchecked: bool = Fa
 
 
 def add(
-  chosen: Setting, results: pathlib.Path, zoo_folder: pathlib.Path, link_unchecked: bool = False
-) -> tuple[list[zoo.Entry], list[pathlib.Path], list[str]]:
+  chosen: CachedSetting,
+  results: pathlib.Path,
+  zoo_folder: pathlib.Path,
+  link_unchecked: bool = False,
+) -> tuple[list[zoo.ZooFile], list[pathlib.Path], list[str]]:
   """``zoo.add`` of the setting's cache files, each seed's checkpoint linked to the records in
   ``results`` that its weights made (``records_of``); returns the entries added, the cache files
   skipped and the records not linked because they name no weights."""
@@ -221,7 +225,7 @@ def add(
   return added, skipped, links.unchecked
 
 
-def _sharing_forward_models(chosen: Setting) -> list[Setting]:
+def _sharing_forward_models(chosen: CachedSetting) -> list[CachedSetting]:
   """The other settings whose agents may read ``chosen``'s forward models: every other agent
   trained on babbling, on the same robot at the same profile and seeds (none for Exp1S)."""
   if chosen.family is not None:
@@ -233,10 +237,9 @@ def _sharing_forward_models(chosen: Setting) -> list[Setting]:
   ]
 
 
-def remove(chosen: Setting, zoo_folder: pathlib.Path) -> list[zoo.Entry]:
-  """``zoo.remove`` of what the zoo holds of the setting: each seed's checkpoint or unfinished
-  training, and the forward models that no other agent in the zoo reads; returns the entries
-  removed.
+def remove(chosen: CachedSetting, zoo_folder: pathlib.Path) -> list[zoo.ZooFile]:
+  """``zoo.remove`` of what the zoo holds of the setting: each seed's checkpoint, and the forward
+  models that no other agent in the zoo reads; returns the entries removed.
 
   Raises:
     ValueError: the zoo holds nothing of the setting (one line; nothing is changed).
@@ -245,7 +248,7 @@ def remove(chosen: Setting, zoo_folder: pathlib.Path) -> list[zoo.Entry]:
   home = storage.softbench_home()
 
   def held(path: pathlib.Path) -> set[str]:
-    return zoo.held_for(path.relative_to(home).as_posix(), entries)
+    return {path.relative_to(home).as_posix()} & set(entries)
 
   own = cache_files(chosen)
   if not any(held(path) for _, path, kind in own if kind == "agent"):

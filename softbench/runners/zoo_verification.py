@@ -20,6 +20,7 @@ from softbench import robots
 from softbench import storage
 from softbench import zoo
 from softbench.leaderboard import verified
+from softbench.learning import exp1s as exp1s_training
 from softbench.records import fields as record_fields
 from softbench.records import provenance
 from softbench.robots import versions
@@ -78,7 +79,7 @@ def empty_data_home(references: pathlib.Path | None = None) -> Iterator[pathlib.
         os.environ[storage.HOME_VARIABLE] = previous
 
 
-def agent_of(entry: zoo.Entry) -> str:
+def agent_of(entry: zoo.ZooFile) -> str:
   """The agent whose weights ``entry`` holds (an Exp1S network is smpl's)."""
   return entry.config.get("agent", "smpl")
 
@@ -107,7 +108,7 @@ def rescored(record: dict, seed: int) -> dict:
     family = next(
       name
       for name in robots.TENDON_FAMILIES
-      if continual.protocol(name).robot_names == tuple(record["robots"])
+      if exp1s_training.protocol(name).robot_names == tuple(record["robots"])
     )
     with tempfile.TemporaryDirectory() as kept:
       entry = continual.score_seed(seed, profile, False, pathlib.Path(kept), family)

@@ -135,12 +135,12 @@ def execute(
     outcomes[run][seed] = outcome
   written, failures = [], {}
 
-  def complete(run: grid.Setting) -> None:
+  def complete(run: grid.GridSetting) -> None:
     if len(outcomes[run]) < run.seeds or run in failures:
       return
     in_order = [outcomes[run][seed] for seed in range(run.seeds)]
     wall_time_s = time.perf_counter() - started
-    if isinstance(run, continual.RunSettings):
+    if isinstance(run, continual.Exp1sSettings):
       record = continual.assemble_record(run, origin, in_order, plan.taken[run], wall_time_s)
       files = saving.save(continual, record, results, ends_command=False)
       continual.finish(record, files)
@@ -182,7 +182,7 @@ def execute(
           if isinstance(task, grid.Build):
             shipping.write_missing(value)
           else:
-            if isinstance(task.run, continual.RunSettings):
+            if isinstance(task.run, continual.Exp1sSettings):
               continual.keep_scores(task.run, task.seed, value)
             else:
               episode_snapshots.save(task.run, task.seed, value[1])

@@ -32,14 +32,17 @@ from softbench import zoo
 from softbench.agents import learned
 from softbench.agents import learners
 from softbench.data import dataset as babbling_dataset
+from softbench.learning import checkpoints
+from softbench.learning import exp1s as exp1s_training
 from softbench.learning import forward_models
+from softbench.learning import inverse as inverse_training
 from softbench.records import fields as record_fields
 from softbench.robots import versions
 from softbench.runners import continual
 from softbench.runners import run as run_module
 
 KINDS = ("dataset", "forward", "agent", "network")  # What a build makes (network: Exp1S's).
-Setting = run_module.RunSettings | continual.RunSettings  # A task's run, or an Exp1S run.
+GridSetting = run_module.RunSettings | continual.Exp1sSettings  # A task's run, or an Exp1S run.
 
 
 @dataclasses.dataclass(frozen=True)
@@ -81,7 +84,7 @@ class Grid:
     ]
     return list(dict.fromkeys(every))  # A name given twice is one setting.
 
-  def protocol_settings(self) -> list[continual.RunSettings]:
+  def protocol_settings(self) -> list[continual.Exp1sSettings]:
     """The Exp1S run of each family once, checked (``continual.settings``), its seeds resolved.
 
     Raises:
@@ -114,7 +117,7 @@ class Evaluation:
   spot, as an agent that does not learn is); of an Exp1S run, one seed's scores, by the network
   that ``agent`` builds."""
 
-  run: Setting
+  run: GridSetting
   seed: int
   agent: Build | None
 
@@ -130,13 +133,13 @@ class Plan:
   it needs), those of them the data home holds (shipped, not built), and the zoo files taken for
   each setting's checkpoints (``run.take_from_zoo``)."""
 
-  settings: tuple[Setting, ...]
+  settings: tuple[GridSetting, ...]
   skipped: tuple[pathlib.Path, ...]
-  resumed: dict[tuple[Setting, int], tuple[dict, episodes.Episode] | dict]
+  resumed: dict[tuple[GridSetting, int], tuple[dict, episodes.Episode] | dict]
   evaluations: tuple[Evaluation, ...]
   builds: tuple[Build, ...]
   found: frozenset[Build]
-  taken: dict[Setting, list[str]]
+  taken: dict[GridSetting, list[str]]
 
   def report(self) -> str:
     """What the sweep would do, a line per setting to run, as ``softbench sweep --dry-run``
@@ -156,15 +159,15 @@ class Plan:
     return "\n".join(lines)
 
 
-def setting_name(run: Setting) -> str:
+def setting_name(run: GridSetting) -> str:
   """``agent-robot-task-profile-eval``, as its record's file name begins; of an Exp1S run,
   ``smpl-exp1s-[family-]profile``, as its record's."""
-  if isinstance(run, continual.RunSettings):
+  if isinstance(run, continual.Exp1sSettings):
     return continual.run_name(run.profile.name, run.family)
   return f"{run.agent}-{run.robot}-{run.task}-{run.profile.name}-{run.eval_mode}"
 
 
-def existing_record(run: Setting, results: pathlib.Path) -> pathlib.Path | None:
+def existing_record(run: GridSetting, results: pathlib.Path) -> pathlib.Path | None:
   """The oldest record of ``run``'s setting in ``results``: a file named ``setting_name``, then a
   date, as ``run.record_path`` (or ``continual.record_path``) names it, that was simulated with
   the installed physics version and holds as many seeds and, for a task, completed partial
@@ -183,9 +186,9 @@ def existing_record(run: Setting, results: pathlib.Path) -> pathlib.Path | None:
   return None
 
 
-def _unnamed_settings(run: Setting) -> dict:
+def _unnamed_settings(run: GridSetting) -> dict:
   """The settings of ``run`` that its record holds but its file name does not say."""
-  if isinstance(run, continual.RunSettings):
+  if isinstance(run, continual.Exp1sSettings):
     return {"seeds": run.seeds}
   return {"seeds": run.seeds, "helpers": run.helpers}
 
@@ -195,7 +198,7 @@ def _relative(path: pathlib.Path) -> str:
 
 
 def _dataset_build(robot: str, profile: profiles.Profile) -> Build:
-  config = babbling_dataset.generating_config(robot, profile.samples, learned.DATA_SEED)
+  config = babbling_dataset.generating_config(robot, profile.samples, inverse_training.DATA_SEED)
   folder = babbling_dataset.dataset_folder(config)
   return Build(
     "dataset",
@@ -217,9 +220,9 @@ def _forward_builds(
     arm,
     views,
     profile.samples,
-    learned.DATA_SEED,
-    learned.forward_config(seed, profile),
-    learned.TRAINING_VERSION,
+    inverse_training.DATA_SEED,
+    inverse_training.forward_config(seed, profile),
+    checkpoints.TRAINING_VERSION,
   )
   return tuple(
     Build(
@@ -255,10 +258,10 @@ def agent_build(agent: str, robot: str, seed: int, profile: profiles.Profile) ->
   )
 
 
-def network_build(run: continual.RunSettings, seed: int) -> Build:
+def network_build(run: continual.Exp1sSettings, seed: int) -> Build:
   """The build of an Exp1S seed's network (``continual.build``): it needs the babbling dataset
   of each of the family's arms."""
-  arms = dict.fromkeys(arm.name for arm, _ in continual.protocol(run.family).column_views())
+  arms = dict.fromkeys(arm.name for arm, _ in exp1s_training.protocol(run.family).column_views())
   return Build(
     "network",
     f"network {continual.PROTOCOL} {run.family} seed {seed}",
@@ -274,7 +277,7 @@ def is_found(build: Build) -> bool:
   return bool(build.files) and all((home / name).is_file() for name in build.files)
 
 
-UNFINISHED_SUFFIXES = (zoo.PARTIAL_SUFFIX, ".partial.pt")
+UNFINISHED_SUFFIXES = (checkpoints.SNAPSHOT_SUFFIX, ".partial.pt")
 """Where a cache file's unfinished training keeps its state, beside it: ``KEY.partial/`` (a
 babbling learner, a forward model; ``smpl.snapshots``) or ``KEY.partial.pt`` (sac)."""
 
@@ -294,32 +297,32 @@ def is_under_way(build: Build) -> bool:
   return resumes(build) or any(is_under_way(need) for need in build.needs)
 
 
-def _zoo_key(run: Setting) -> tuple:
+def _zoo_key(run: GridSetting) -> tuple:
   """What the checkpoints that ``run`` takes from the zoo depend on (shared by a task's runs)."""
-  if isinstance(run, continual.RunSettings):
+  if isinstance(run, continual.Exp1sSettings):
     return run
   return (run.agent, run.robot, run.profile, run.seeds)
 
 
-def _take_from_zoo(run: Setting) -> list[str]:
+def _take_from_zoo(run: GridSetting) -> list[str]:
   """The zoo files taken for the checkpoints of ``run``'s seeds that the data home lacks."""
-  if isinstance(run, continual.RunSettings):
+  if isinstance(run, continual.Exp1sSettings):
     paths = [continual.checkpoint_path(seed, run.profile, run.family) for seed in range(run.seeds)]
     return zoo.take(paths)[0]
   return run_module.take_from_zoo(run)[0]
 
 
-def _resumed_seed(run: Setting, seed: int) -> tuple[dict, episodes.Episode] | dict | None:
+def _resumed_seed(run: GridSetting, seed: int) -> tuple[dict, episodes.Episode] | dict | None:
   """What an interrupted run or sweep kept of ``seed``: a task's entry and episode, an Exp1S
   seed's scores; None if nothing."""
-  if isinstance(run, continual.RunSettings):
+  if isinstance(run, continual.Exp1sSettings):
     return continual.kept_scores(run, seed)
   return run_module.resumed_seed(run, seed)
 
 
-def _seed_build(run: Setting, seed: int) -> Build | None:
+def _seed_build(run: GridSetting, seed: int) -> Build | None:
   """The build that ``seed``'s evaluation of ``run`` needs (None: none)."""
-  if isinstance(run, continual.RunSettings):
+  if isinstance(run, continual.Exp1sSettings):
     return network_build(run, seed)
   return agent_build(run.agent, run.robot, seed, run.profile)
 

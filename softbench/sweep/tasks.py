@@ -19,9 +19,9 @@ from softbench import data
 from softbench import progress
 from softbench import robots
 from softbench import terminal
-from softbench.agents import learned
 from softbench.agents import learners
 from softbench.episodes import snapshots as episode_snapshots
+from softbench.learning import inverse as inverse_training
 from softbench.runners import continual
 from softbench.runners import run as run_module
 from softbench.sweep import relay
@@ -47,13 +47,17 @@ def _relayed(states: relay.Relay | None) -> Iterator[None]:
 def _collect(robot: str, samples: int) -> None:
   """The babbling dataset, simulated on as many threads as the task has cores."""
   cores = int(ray.get_runtime_context().get_assigned_resources().get("CPU", 1))
-  data.collect(robot, samples=samples, seed=learned.DATA_SEED, workers=cores, progress=False)
+  data.collect(
+    robot, samples=samples, seed=inverse_training.DATA_SEED, workers=cores, progress=False
+  )
 
 
 def _train_forward_model(robot: str, per_module: bool, view: int, seed: int, profile) -> None:
   """The forward model of view ``view`` of the agents with ``per_module`` (``learners.views``)."""
   arm = robots.make(robot)
-  learned.trained_forward_models(arm, [learners.views(arm, per_module)[view]], seed, profile)
+  inverse_training.trained_forward_models(
+    arm, [learners.views(arm, per_module)[view]], seed, profile
+  )
 
 
 def _build_agent(agent: str, robot: str, seed: int, profile) -> None:
@@ -88,7 +92,7 @@ def build(
 
 
 def evaluate(
-  run: run_module.RunSettings | continual.RunSettings,
+  run: run_module.RunSettings | continual.Exp1sSettings,
   seed: int,
   *needed: shipping.Files,
   states: relay.Relay | None = None,
@@ -97,7 +101,7 @@ def evaluate(
   an Exp1S run, the seed's scores, by the network of ``needed``. ``states``: as ``build``'s."""
   with _relayed(states):
     shipping.write_missing(*needed)
-    if isinstance(run, continual.RunSettings):
+    if isinstance(run, continual.Exp1sSettings):
       return continual.run_seed(seed, run.profile, run.family)
     return run_module.fresh_seed(run, seed)
 

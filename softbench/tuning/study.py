@@ -1,14 +1,13 @@
 """Optuna studies that tune a learned agent's hyperparameters on validation data.
 
 Every learned agent gets the same study: its search space (``agents.hyperparameters``), the same
-number of trials, a seeded TPE sampler and a median pruner fed with per-epoch validation losses.
-A trial trains the agent's inverse model with the sampled values in closed loop through frozen
-forward models (trained once and shared, ``agents.forward_models``), on the profile's babbling
-dataset and with the study's seed, as ``softbench run`` trains the agent's seed (for at most
-``epochs`` epochs, the profile's unless a study asks for fewer to afford more trials); its value
-is the best validation loss: the action MSE over the whole arm on the validation split, in
-normalised units, the VAE's KL term left out (``learned.train_inverse``), the same quantity for
-every agent.
+number of trials, a seeded TPE sampler and a median pruner fed with per-epoch validation losses. A
+trial trains the agent's inverse model with the sampled values in closed loop through frozen forward
+models (trained once and shared, ``learning.forward_models``), on the profile's babbling dataset and
+with the study's seed, as ``softbench run`` trains the agent's seed (for at most ``epochs`` epochs,
+the profile's unless a study asks for fewer to afford more trials); its value is the best validation
+loss: the action MSE over the whole arm on the validation split, in normalised units, the VAE's KL
+term left out (``inverse_training.train_inverse``), the same quantity for every agent.
 
 The first trial is the agent's values in use when the study starts (``hyperparameters.json``),
 so each study measures the values it replaces on the same data. Studies live in an Optuna storage
@@ -37,8 +36,9 @@ from softbench import progress as progress_bars
 from softbench import robots
 from softbench import storage
 from softbench.agents import hyperparameters
-from softbench.agents import learned
 from softbench.data import dataset
+from softbench.learning import checkpoints
+from softbench.learning import inverse as inverse_training
 from softbench.tuning import report
 
 DEFAULT_TRIALS = 10  # Trials per study, the same for every agent (docs/tuning.md: budget).
@@ -93,7 +93,7 @@ class TuneSettings:
       "compile": self.profile.compile,
       "seed": self.seed,
       "search_space": hyperparameters.describe_space(self.agent),
-      "training_version": learned.TRAINING_VERSION,
+      "training_version": checkpoints.TRAINING_VERSION,
     }
 
 
@@ -236,14 +236,17 @@ class _Trainer:
     self.space = hyperparameters.search_space(settings.agent)
     arm = robots.make(settings.robot)
     self.views = self.learner.views(arm)
-    self.windows, self.forwards = learned.trained_forward_models(
+    self.windows, self.forwards = inverse_training.trained_forward_models(
       arm, self.views, settings.seed, settings.profile, show_progress
     )
 
   def validation_loss(
-    self, params: dict, profile: profiles.Profile, on_epoch: learned.EpochCallback | None = None
+    self,
+    params: dict,
+    profile: profiles.Profile,
+    on_epoch: inverse_training.EpochCallback | None = None,
   ) -> float:
-    _, loss = learned.train_inverse(
+    _, loss = inverse_training.train_inverse(
       self.views,
       self.windows,
       self.forwards,

@@ -1,13 +1,14 @@
-"""The zoo: trained weights kept in the repository, so that a fresh clone re-scores a record
-without training, and a long training goes on from another machine.
+"""The zoo: finished trained weights kept in the repository, so that a fresh clone re-scores a
+record without training.
 
 ``zoo/`` holds files laid out as in the data home, each under the path the cache looks for:
 
 - ``checkpoints/KEY.pt``: a trained agent (an Exp2S agent or an Exp1S network), weights only;
-- ``forward/KEY.pt``: a frozen forward model, shared by the agents that read its view;
-- ``checkpoints/KEY.partial/fit-N.pt`` (or ``forward/KEY.partial/...``): the saved state of a
-  training that has not finished (``smpl.snapshots``), optimiser included, so that it resumes
-  to the same weights; removed once that checkpoint is in.
+- ``forward/KEY.pt``: a frozen forward model, shared by the agents that read its view.
+
+Never the state of an unfinished training (``KEY.partial/``, optimiser included): it is replaced
+at every save, and each one committed stays in the history for good (162 MB of BiLSTM training
+states did). An interrupted training resumes from the data home it ran in (docs/layout.md).
 
 ``zoo/manifest.json`` lists every file with its sha256, size, kind, the cache key it answers (and
 the configuration stored in it) and the records it stands behind. Before the cache trains a model
@@ -40,10 +41,9 @@ OFF = "none"
 MANIFEST = "manifest.json"
 FORMAT = "softbench-zoo"
 VERSION = 1
-KINDS = ("agent", "forward", "training-state")
+KINDS = ("agent", "forward")
 MB = 10**6  # (bytes) A megabyte, as the zoo's sizes are given.
 BUDGET_BYTES = 100 * MB  # (bytes) What the repository's zoo may hold in all: 100 MB.
-PARTIAL_SUFFIX = ".partial"  # A cache file's training state: KEY.partial/ beside KEY.pt.
 _REPOSITORY_ZOO = pathlib.Path(__file__).resolve().parents[2] / "zoo"  # Of a source checkout.
 
 
@@ -52,7 +52,7 @@ class ZooWarning(UserWarning):
 
 
 @dataclasses.dataclass(frozen=True)
-class Entry:
+class ZooFile:
   """One file of the zoo; ``path`` is relative to the zoo and to the data home alike."""
 
   path: str
@@ -122,7 +122,7 @@ def file_sha256(path: pathlib.Path) -> str:
   return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
-def read_manifest(zoo: pathlib.Path) -> dict[str, Entry]:
+def read_manifest(zoo: pathlib.Path) -> dict[str, ZooFile]:
   """The entries of ``zoo``'s manifest by path; none if it has no manifest.
 
   Raises:
@@ -136,7 +136,7 @@ def read_manifest(zoo: pathlib.Path) -> dict[str, Entry]:
     if content.get("format") != FORMAT or content.get("version") != VERSION:
       raise ValueError(f"not a {FORMAT} manifest of version {VERSION}")
     entries = [
-      Entry(**{**entry, "records": tuple(entry["records"])}) for entry in content["entries"]
+      ZooFile(**{**entry, "records": tuple(entry["records"])}) for entry in content["entries"]
     ]
     if any(entry.kind not in KINDS or not _inside(entry.path) for entry in entries):
       raise ValueError("an entry of unknown kind or with a path outside the zoo")
@@ -159,7 +159,7 @@ def _inside(relative: str) -> bool:
   return bool(parts) and not pathlib.PurePosixPath(relative).is_absolute() and ".." not in parts
 
 
-def write_manifest(zoo: pathlib.Path, entries: dict[str, Entry]) -> None:
+def write_manifest(zoo: pathlib.Path, entries: dict[str, ZooFile]) -> None:
   content = {
     "format": FORMAT,
     "version": VERSION,
@@ -173,9 +173,8 @@ def _say(message: str) -> None:
 
 
 def restore(cache_file: pathlib.Path) -> list[str]:
-  """Brings what the zoo holds for ``cache_file`` (a checkpoint or forward model under the data
-  home) into the data home, if the home lacks it: the finished file, else the saved state of its
-  unfinished training when the home has none of its own. Returns the zoo paths taken.
+  """Brings the zoo's copy of ``cache_file`` (a checkpoint or forward model under the data home)
+  into the data home, if the home lacks it. Returns the zoo paths taken.
 
   A file whose bytes differ from the manifest's sha256 is refused with a ``ZooWarning`` (one
   line), as is an unreadable manifest; the model is then trained as if the zoo had nothing."""
@@ -195,17 +194,7 @@ def restore(cache_file: pathlib.Path) -> list[str]:
   if relative in entries and _copy_checked(zoo, entries[relative], home):
     _say(f"took {relative} instead of training it (sha256 checked)")
     return [relative]
-  partial = pathlib.PurePosixPath(relative).with_suffix(PARTIAL_SUFFIX).as_posix()
-  state = [entry for path, entry in sorted(entries.items()) if path.startswith(partial + "/")]
-  if not state or (home / partial).exists():
-    return []
-  taken = [entry.path for entry in state if _copy_checked(zoo, entry, home)]
-  if taken:
-    _say(
-      f"resuming the training of {pathlib.PurePosixPath(relative).stem} from its saved "
-      f"state ({len(taken)} of {len(state)} files)"
-    )
-  return taken
+  return []
 
 
 def take(cache_files: list[pathlib.Path]) -> tuple[list[str], bool]:
@@ -240,7 +229,7 @@ def weights_section(per_seed_files: list[list[pathlib.Path]]) -> dict:
   return {"weights": {"per_seed": hashed}} if hashed else {}
 
 
-def _copy_checked(zoo: pathlib.Path, entry: Entry, home: pathlib.Path) -> bool:
+def _copy_checked(zoo: pathlib.Path, entry: ZooFile, home: pathlib.Path) -> bool:
   """Copies the zoo's ``entry`` into the data home if its bytes match the manifest's sha256."""
   source = zoo / entry.path
   try:
@@ -280,64 +269,49 @@ def add(
   records_of: dict[pathlib.Path, list[str]],
   zoo: pathlib.Path,
   budget_bytes: int | None = BUDGET_BYTES,
-) -> tuple[list[Entry], list[pathlib.Path]]:
-  """Copies each ``(cache file, kind)`` from the data home into ``zoo``, or, for one not yet
-  written, the saved state of its unfinished training (``KEY.partial/``, which replaces the
-  state the zoo held for it); a finished file replaces the training state the zoo held for it.
-  ``records_of`` names the records each file stands behind. Returns the new or changed entries,
-  and the cache files skipped because their training has not started in the data home.
+) -> tuple[list[ZooFile], list[pathlib.Path]]:
+  """Copies each finished ``(cache file, kind)`` of the data home into ``zoo``; ``records_of``
+  names the records each file stands behind. Returns the new or changed entries, and the cache
+  files skipped because the data home holds no finished file for them (an unfinished training's
+  state is never taken: module docstring).
 
   Raises:
-    ValueError: no file is trained or under way in the data home, or the zoo would outgrow
-      ``budget_bytes`` (one line; nothing is changed).
+    ValueError: no file is finished in the data home, or the zoo would outgrow ``budget_bytes``
+      (one line; nothing is changed).
   """
   home = storage.softbench_home()
   before = read_manifest(zoo)
   entries = dict(before)
-  planned: dict[str, tuple[bytes, Entry]] = {}
+  planned: dict[str, tuple[bytes, ZooFile]] = {}
   skipped = []
   for cache_file, kind in cache_files:
-    relative = cache_file.relative_to(home).as_posix()
-    partial = cache_file.with_suffix(PARTIAL_SUFFIX)
-    if cache_file.is_file():
-      sources = [(cache_file, kind, stored_config(cache_file))]
-    elif partial.is_dir() and any(partial.iterdir()):
-      sources = [
-        (path, "training-state", {}) for path in sorted(partial.iterdir()) if path.is_file()
-      ]
-    else:
+    if not cache_file.is_file():
       skipped.append(cache_file)
       continue
-    # The zoo's training state of this file is replaced: by the finished file, or by the state
-    # the data home holds now.
-    state = held_for(relative, entries) - {relative}
-    entries = {path: entry for path, entry in entries.items() if path not in state}
-    for source, source_kind, config in sources:
-      path = source.relative_to(home).as_posix()
-      records = tuple(
-        sorted(
-          set(records_of.get(cache_file, ()))
-          | set(entries[path].records if path in entries else ())
-        )
+    path = cache_file.relative_to(home).as_posix()
+    records = tuple(
+      sorted(
+        set(records_of.get(cache_file, ())) | set(entries[path].records if path in entries else ())
       )
-      content = source.read_bytes()  # Read once: hashed now, written below.
-      planned[path] = (
-        content,
-        Entry(
-          path,
-          hashlib.sha256(content).hexdigest(),
-          len(content),
-          source_kind,
-          cache_file.stem,
-          config,
-          records,
-          _installed_physics(),
-        ),
-      )
+    )
+    content = cache_file.read_bytes()  # Read once: hashed now, written below.
+    planned[path] = (
+      content,
+      ZooFile(
+        path,
+        hashlib.sha256(content).hexdigest(),
+        len(content),
+        kind,
+        cache_file.stem,
+        stored_config(cache_file),
+        records,
+        _installed_physics(),
+      ),
+    )
   if not planned:
     raise ValueError(
-      f"nothing of this setting is trained or being trained in the data home "
-      f"{home}; run its training first"
+      f"nothing of this setting has finished training in the data home {home}; run its "
+      f"training to the end first (the zoo holds finished weights only)"
     )
   updated = {**entries, **{path: entry for path, (_, entry) in planned.items()}}
   total = size_bytes(updated)
@@ -355,14 +329,7 @@ def add(
   return [entry for _, entry in planned.values()], skipped
 
 
-def held_for(relative: str, entries: dict[str, Entry]) -> set[str]:
-  """The paths of ``entries`` that a cache file (its data-home path ``relative``) stands for: the
-  file itself and the saved state of its unfinished training (``KEY.partial/...``)."""
-  prefix = pathlib.PurePosixPath(relative).with_suffix(PARTIAL_SUFFIX).as_posix() + "/"
-  return {path for path in entries if path == relative or path.startswith(prefix)}
-
-
-def remove(paths: set[str], zoo: pathlib.Path) -> list[Entry]:
+def remove(paths: set[str], zoo: pathlib.Path) -> list[ZooFile]:
   """Removes the entries at ``paths`` (relative to ``zoo``) and their files; returns the entries
   removed. The manifest is written first, so that an interruption leaves at most files it does
   not list (``check_files`` names them), never a listed file that is gone.
@@ -388,7 +355,7 @@ def _remove_empty_parents(path: pathlib.Path, root: pathlib.Path) -> None:
     parent = parent.parent
 
 
-def size_bytes(entries: dict[str, Entry]) -> int:
+def size_bytes(entries: dict[str, ZooFile]) -> int:
   return sum(entry.bytes for entry in entries.values())
 
 

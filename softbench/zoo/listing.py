@@ -12,7 +12,7 @@ from softbench import zoo
 KB = 10**3  # (bytes) A kilobyte.
 
 
-def usage(folder: pathlib.Path, entries: dict[str, zoo.Entry]) -> str:
+def usage(folder: pathlib.Path, entries: dict[str, zoo.ZooFile]) -> str:
   """``1.2 MB of 100 MB (FOLDER)``: what ``entries`` (the zoo ``folder``'s) hold of its
   budget."""
   return (
@@ -36,7 +36,7 @@ def contents(folder: pathlib.Path) -> RenderableType:
 
 
 def additions(
-  added: list[zoo.Entry],
+  added: list[zoo.ZooFile],
   skipped: list[pathlib.Path],
   folder: pathlib.Path,
   unchecked: list[str] = (),
@@ -60,7 +60,7 @@ def additions(
   return "\n".join(lines)
 
 
-def removals(removed: list[zoo.Entry], folder: pathlib.Path) -> str:
+def removals(removed: list[zoo.ZooFile], folder: pathlib.Path) -> str:
   """What ``zoo.remove`` removed, then how much the zoo ``folder`` holds now; one fact a line."""
   lines = [f"removed {entry.path} ({entry.kind}, {entry.bytes / KB:.1f} kB)" for entry in removed]
   lines.append(f"zoo: {usage(folder, zoo.read_manifest(folder))}")

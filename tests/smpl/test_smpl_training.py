@@ -4,7 +4,6 @@ import logging
 import warnings
 
 import pytest
-from rich.console import Console
 import torch
 
 from smpl import training
@@ -13,7 +12,6 @@ from smpl.baselines import LSTMInverse
 from smpl.baselines import MLPInverse
 from smpl.baselines import VAELSTMInverse
 from smpl.forward_model import ForwardModel
-from smpl.progress import EpochProgressBar
 from smpl.progressive import ProgressiveColumn
 from smpl.progressive import ProgressiveLSTM
 from smpl.training import EarlyStopping
@@ -201,25 +199,6 @@ def test_inverse_training_needs_a_frozen_forward_model(
       SHORT_RUN,
       CPU,
     )
-
-
-def test_progress_bar_shows_epochs_done_and_the_latest_losses(
-  arm_data: dict[str, BabblingWindows], trained_forward_model: ForwardModel
-) -> None:
-  output = io.StringIO()
-  with EpochProgressBar("column 1", SHORT_RUN.max_epochs, Console(file=output, width=150)) as bar:
-    result = train_inverse_model(
-      _fresh_column(),
-      trained_forward_model,
-      arm_data["train"],
-      arm_data["validation"],
-      SHORT_RUN,
-      CPU,
-      on_epoch_end=bar,
-    )
-  shown = output.getvalue()
-  assert "column 1" in shown and f"{result.epochs_run}/{SHORT_RUN.max_epochs}" in shown
-  assert f"best {result.best_validation_loss:.2e}" in shown
 
 
 def test_a_compiled_optimiser_step_prints_no_profiler_notice() -> None:

@@ -35,6 +35,7 @@ from softbench import metrics
 from softbench import profiles
 from softbench import suite
 from softbench.agents import learned
+from softbench.records import fields
 from softbench.robots import base as robot_base
 from softbench.runners import evaluation
 from softbench.runners.adaptive import procedure
@@ -138,17 +139,14 @@ def reach_target(
   target = np.array(time_step.observation["target"][0], dtype=float)
   agent.reset(agents.EpisodeInfo("reach", env.task.scored_modules()))
   tips, actions, stage_ends = [time_step.observation["poses"][module - 1, :3]], [], []
-  try:
-    while (stage := staged.next_stage()) is not None:
-      agent.active_modules = stage.active
-      for _ in range(stages.stage_steps):
-        actions.append(agent.act(time_step.observation))
-        time_step = env.step(actions[-1])
-        tips.append(time_step.observation["poses"][module - 1, :3])
-      stage_ends.append(len(actions))
-      staged.report(_settled_error_mm(np.array(tips), target, stages.scored_steps))
-  finally:
-    agent.active_modules = None
+  while (stage := staged.next_stage()) is not None:
+    agent.switch_modules(stage.active)
+    for _ in range(stages.stage_steps):
+      actions.append(agent.act(time_step.observation))
+      time_step = env.step(actions[-1])
+      tips.append(time_step.observation["poses"][module - 1, :3])
+    stage_ends.append(len(actions))
+    staged.report(_settled_error_mm(np.array(tips), target, stages.scored_steps))
   all_on = evaluation.run_episode(
     suite.load(robot, "reach", seed=target_seed, module=module, steps=len(actions)), agent, "reach"
   )
@@ -198,20 +196,16 @@ def reach_targets(
   module = reach.check_module(robot, module)
   check_helpers(helpers)
   threshold = threshold_mm(robot, module) if threshold is None else threshold
-  outcomes, convention = [], agent.helper_targets
-  agent.helper_targets = helpers
-  try:
-    for seed in range(targets):
-      outcomes.append(reach_target(agent, robot, seed, module, stages, threshold))
-      if on_target is not None:
-        on_target()
-  finally:
-    agent.helper_targets = convention
+  agent, outcomes = agent.with_acting(helper_targets=helpers), []
+  for seed in range(targets):
+    outcomes.append(reach_target(agent, robot, seed, module, stages, threshold))
+    if on_target is not None:
+      on_target()
   return outcomes
 
 
 def check_helpers(helpers: str) -> None:
-  if helpers not in learned.HELPER_TARGETS:
+  if helpers not in fields.HELPER_TARGETS:
     raise ValueError(
-      f"unknown helpers {helpers!r}; choose one of {', '.join(learned.HELPER_TARGETS)}"
+      f"unknown helpers {helpers!r}; choose one of {', '.join(fields.HELPER_TARGETS)}"
     )

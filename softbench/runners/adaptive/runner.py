@@ -6,6 +6,7 @@ from softbench import agents
 from softbench import profiles
 from softbench import progress as progress_bars
 from softbench import robots
+from softbench.agents import learned
 from softbench.runners.adaptive import DEFAULT_TARGETS
 from softbench.runners.adaptive import experiment
 from softbench.runners.adaptive import report
@@ -37,10 +38,10 @@ def run(
       f"--adaptive needs an agent trained on babbling "
       f"({', '.join(agents.babbling_learners())}), got {agent!r}"
     )
+  acting = learned.Acting(error_source=eval_mode)
   learner = experiment.check_agent(
-    agents.make(agent, arm, experiment.AGENT_SEED, profile, show_progress)
+    agents.make(agent, arm, experiment.AGENT_SEED, profile, show_progress, acting)
   )
-  learner.error_source = eval_mode
   stages = experiment.timing(arm, profile)
   threshold = experiment.threshold_mm(arm, module)
   progress = progress_bars.counting(show_progress, transient=True)
