@@ -116,6 +116,55 @@ def test_the_cycle_finder_finds_a_cycle():
   assert find_cycle(graph) is None
 
 
+def _unit_modules(unit: str) -> list[str]:
+  """The dotted names of every module of softbench unit ``unit``."""
+  base = PACKAGE / unit
+  paths = sorted(base.rglob("*.py")) if base.is_dir() else [base.with_suffix(".py")]
+  return [
+    ".".join(path.relative_to(PACKAGE.parent).with_suffix("").parts).removesuffix(".__init__")
+    for path in paths
+  ]
+
+
+# (unit, the units it may not import, why)
+BOUNDARIES = (
+  ("leaderboard", {"runners", "sweep", "learning", "cli"}, "the leaderboard only reads records"),
+  ("records", {"runners", "sweep", "learning", "agents", "leaderboard", "cli"}, "records are read"),
+  ("learning", {"agents", "runners", "sweep", "cli"}, "training knows no agent or runner"),
+  ("agents", {"runners", "sweep", "cli"}, "an agent acts; runners run it"),
+  ("runners", {"sweep", "cli"}, "the sweep and the command line call the runners"),
+)
+
+
+@pytest.mark.parametrize(("unit", "forbidden", "why"), BOUNDARIES, ids=[b[0] for b in BOUNDARIES])
+def test_each_layer_imports_only_the_layers_below_it(unit, forbidden, why):
+  """No file of ``unit`` names a forbidden unit in any import statement (deferred ones too), and
+  importing any of its modules loads none."""
+  named = {other: files for other, files in import_graph()[unit].items() if other in forbidden}
+  assert not named, f"{unit} imports {named} ({why})"
+  for module in _unit_modules(unit):
+    loaded = {_unit(name) for name in _loaded_with(module)}
+    assert not loaded & forbidden, f"importing {module} loads {loaded & forbidden} ({why})"
+
+
+# Every module at softbench's top level, and why it is not in a package: a new one says why here.
+TOP_LEVEL_MODULES = {
+  "__init__": "the package: loads triton before EGL",
+  "launcher": "the console entry point: loads MuJoCo before the command line",
+  "metrics": "tracking scores, read by episodes, runners, records and the leaderboard alike",
+  "plots": "matplotlib figures of episodes and results, for runners and the leaderboard",
+  "profiles": "data and epoch budgets, read by every layer",
+  "progress": "progress bars of long work, in every layer",
+  "storage": "the data home, atomic writes and hashes, under every layer",
+  "terminal": "tables, JSON and one-line warnings on the terminal, for every command",
+}
+
+
+def test_the_top_level_holds_packages_and_a_few_modules_that_say_why():
+  modules = {path.stem for path in PACKAGE.glob("*.py")}
+  assert modules == set(TOP_LEVEL_MODULES), sorted(modules ^ set(TOP_LEVEL_MODULES))
+
+
 # The physics side and the environments: tests/test_envs.py.
 @pytest.mark.parametrize(
   "modules",
@@ -123,7 +172,7 @@ def test_the_cycle_finder_finds_a_cycle():
     "softbench.agents, softbench.agents.hyperparameters",
     "softbench.records, softbench.records.exp1s, softbench.records.provenance",
     "softbench.leaderboard, softbench.leaderboard.html_page, softbench.leaderboard.overview",
-    "softbench.listings, softbench.terminal",
+    "softbench.cli.listings, softbench.terminal",
   ],
 )
 def test_the_registries_and_the_records_import_without_torch(modules):
