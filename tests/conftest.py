@@ -9,6 +9,8 @@ import subprocess
 import sys
 import tempfile
 
+import example_task
+import gymnasium
 import pytest
 import worker_hooks
 
@@ -23,12 +25,30 @@ from softbench.data import dataset as data_files
 from softbench.learning import inverse as inverse_training
 from softbench.learning import protocols
 from softbench.runners import continual
+from softbench.suite import registry as task_registry
 
 
 @pytest.fixture(autouse=True)
 def no_repository_zoo(monkeypatch):
   """Tests train what they use: the repository's zoo stays out unless a test names a zoo."""
   monkeypatch.setenv(zoo.VARIABLE, zoo.OFF)
+
+
+@pytest.fixture
+def restored_tasks(monkeypatch):
+  """The task registry and Gymnasium's ids as they were, after the test."""
+  monkeypatch.setattr(task_registry, "_TASKS", dict(task_registry._TASKS))
+  known_ids = set(gymnasium.registry)
+  yield
+  for added in set(gymnasium.registry) - known_ids:  # The Gymnasium ids of a registered task.
+    del gymnasium.registry[added]
+
+
+@pytest.fixture
+def figure_eight(restored_tasks) -> str:
+  """The name of tracking task ``figure_eight``, registered from outside softbench for the test
+  (``example_task.register_figure_eight``)."""
+  return example_task.register_figure_eight()
 
 
 @pytest.fixture(scope="session")

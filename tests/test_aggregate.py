@@ -8,19 +8,22 @@ import numpy as np
 import pytest
 
 from softbench import leaderboard
+from softbench import records
 from softbench.leaderboard import aggregate
+from softbench.leaderboard import ranking
 
 RESULTS = pathlib.Path(__file__).resolve().parents[1] / "leaderboard" / "results"
 PHYSICS = "v0"  # The committed records of physics v0 are complete and no longer change.
 
 
-def _board():
+@pytest.fixture(scope="module")
+def board():
   return leaderboard.build(RESULTS).of_physics(PHYSICS)
 
 
 @pytest.fixture(scope="module")
-def views():
-  return aggregate.views(_board())
+def views(board):
+  return aggregate.views(board)
 
 
 def test_the_iqm_is_the_mean_of_the_middle_half_of_the_runs():
@@ -48,9 +51,8 @@ def test_a_performance_profile_rises_from_none_to_every_run():
   )
 
 
-def test_every_aggregate_is_the_iqm_of_its_records_per_seed_errors(views):
+def test_every_aggregate_is_the_iqm_of_its_records_per_seed_errors(views, board):
   assert views, "the committed records make no aggregate"
-  board = _board()
   shown = {
     (group.robot, group.task, entry.setting): entry
     for group in board.groups
@@ -68,16 +70,16 @@ def test_every_aggregate_is_the_iqm_of_its_records_per_seed_errors(views):
             "per_seed"
           ]
         ]
-        for task in aggregate.TASKS
+        for task in view.tasks
       ]
       ordered = np.sort(np.concatenate(per_task))
       cut = int(aggregate.TRIMMED * len(ordered))  # Whole runs cut from each end.
       assert found.iqm == pytest.approx(np.mean(ordered[cut : len(ordered) - cut]))
 
 
-def test_an_agent_without_every_task_is_left_out(views):
-  board = _board()
+def test_the_committed_views_aggregate_every_tracking_task_and_every_agent_has_them(views, board):
   for view in views:
+    assert view.tasks == aggregate.tasks() and view.complete == view.aggregates
     for found in view.aggregates:
       tasks = {
         group.task
@@ -86,11 +88,46 @@ def test_an_agent_without_every_task_is_left_out(views):
         for entry in group.entries
         if entry.setting == (found.agent, view.profile, view.eval_mode)
       }
-      assert set(aggregate.TASKS) <= tasks
+      assert set(view.tasks) <= tasks
 
 
-def test_the_pages_show_every_aggregate_and_its_profile_plot(views, tmp_path):
-  board = _board()
+def test_an_agent_without_a_record_of_a_new_task_is_shown_with_it_marked(
+  views, board, figure_eight, tmp_path
+):
+  # A task registered after the records were made: one agent has run it, the others are shown
+  # as before, the new task named in place of their IQM, ranked after the agent with every task.
+  (view,) = [view for view in views if (view.robot, view.profile) == ("tendon-3", "default")]
+  folder = tmp_path / "results"
+  for group, entry in ranking.plain_entries(board):
+    if group.robot == view.robot and entry.setting[1:] == (view.profile, view.eval_mode):
+      records.write(entry.record, folder / f"{entry.setting[0]}-{group.task}.json")
+      if (entry.setting[0], group.task) == ("smpl", "spiral"):
+        records.write({**entry.record, "task": figure_eight}, folder / "smpl-eight.json")
+  with_eight = leaderboard.build(folder).of_physics(PHYSICS)
+  (shown,) = aggregate.views(with_eight)
+  assert shown.tasks == (*view.tasks, figure_eight)
+  assert sorted(found.agent for found in shown.aggregates) == sorted(
+    found.agent for found in view.aggregates
+  )
+  assert shown.complete == shown.aggregates[:1] and shown.complete[0].agent == "smpl"
+  rows = {row[0]: row for row in shown.table.rows}
+  for found in shown.aggregates[1:]:
+    assert found.missing == (figure_eight,) and found.iqm is None
+    assert rows[found.agent][2:] == (f"- (no {figure_eight})", "-", "-")
+  written = leaderboard.write(with_eight, folder, tmp_path)
+  assert tmp_path / shown.image in written
+  assert f"| zero | 20 | - (no {figure_eight}) | - | - |" in (tmp_path / "README.md").read_text()
+
+
+def test_a_new_task_nobody_has_run_leaves_the_views_as_they_were(views, board, figure_eight):
+  again = aggregate.views(board)
+  assert [(view.title, view.tasks, view.table.rows) for view in again] == [
+    (view.title, view.tasks, view.table.rows) for view in views
+  ]
+  assert all(view.table.caption.endswith(f"; no record yet of {figure_eight}") for view in again)
+
+
+def test_the_pages_show_every_aggregate_and_its_profile_plot(views, board, tmp_path):
   written = leaderboard.write(board, RESULTS, tmp_path)
   page = (tmp_path / "README.md").read_text()
   html = (tmp_path / "index.html").read_text()

@@ -640,7 +640,7 @@ def test_a_video_column_only_where_a_record_has_a_video(contest, results, tmp_pa
 def test_an_aggregate_has_no_spread_to_show(real_record, tmp_path):
   # The IQM's chart once read "1.23 ± 0.000" in its tooltips: an IQM has an interval, no std.
   folder = tmp_path / "results"
-  for task in aggregate.TASKS:
+  for task in aggregate.tasks():
     for agent, scale in (("smpl", 1.0), ("lstm", 0.5)):
       records.write(
         variant(real_record, agent, scale=scale, task=task), folder / f"{agent}-{task}.json"

@@ -2,6 +2,7 @@
 task (``example_task.py``) each join by one registry line, and then build, train, run and score
 through the same code as the built-in ones. Registration is undone after each test."""
 
+import dataclasses
 import json
 import os
 import subprocess
@@ -26,22 +27,15 @@ ROBOT = "tendon-1"
 
 
 @pytest.fixture
-def restored_registries(monkeypatch):
-  """The agent and task registries as they were, after the test."""
+def restored_registries(monkeypatch, restored_tasks):
+  """The agent and task registries (and Gymnasium's ids) as they were, after the test."""
   monkeypatch.setattr(agents, "_AGENTS", dict(agents._AGENTS))
   monkeypatch.setattr(agents, "AGENTS", agents.AGENTS)
-  monkeypatch.setattr(suite, "_TASKS", dict(suite._TASKS))
-  for name in ("TASKS", "ALL_TASKS", "BENCHMARKING"):
-    monkeypatch.setattr(suite, name, getattr(suite, name))
-  known_ids = set(gymnasium.registry)
-  yield
-  for added in set(gymnasium.registry) - known_ids:  # The Gymnasium ids of a registered task.
-    del gymnasium.registry[added]
 
 
 def _register_examples() -> None:
-  # The one registry entry each addition takes (in the package: a line of agents._AGENTS or
-  # suite._TASKS):
+  # The one registry entry each addition takes (in the package: a line of agents._AGENTS or a
+  # suite.register call):
   agents.register(
     "linear",
     agents.AgentEntry(
@@ -51,7 +45,11 @@ def _register_examples() -> None:
   suite.register(
     "hold",
     suite.TaskEntry(
-      example_task.Hold, ("benchmarking",), "hold the starting pose", "tendon-3", "steps"
+      build=example_task.Hold,
+      tags=("benchmarking",),
+      description="hold the starting pose",
+      paper_robot="tendon-3",
+      length_option="steps",
     ),
   )
 
@@ -102,8 +100,17 @@ def test_registration_is_undone_between_tests():
     ),
     (lambda: suite.register("spiral", suite.describe("spiral")), "registered already"),
     (
-      lambda: suite.register("new", suite.describe("spiral")._replace(paper_robot="octopus")),
+      lambda: suite.register(
+        "new", dataclasses.replace(suite.describe("spiral"), paper_robot="octopus")
+      ),
       "unknown robot",
+    ),
+    (lambda: suite.register("new", ("build", (), "", "tendon-3", None)), "a TaskEntry"),
+    (lambda: suite.tracking_task("no default")(lambda length, laps: length), "needs a default"),
+    (lambda: suite.tracking_task("robot first", planar=False)(lambda length: 0), "must take"),
+    (
+      lambda: suite.tracking_task("an array")(lambda length, size=np.ones(2): length),
+      "numbers, strings",
     ),
   ],
 )

@@ -9,6 +9,7 @@ import re
 import warnings
 
 from dm_env import specs
+import example_task
 import numpy as np
 import pytest
 
@@ -21,6 +22,7 @@ from softbench import suite
 from softbench import terminal
 from softbench.robots import recorder
 from softbench.suite import references
+from softbench.suite import registry
 
 SHORT_STEPS = 3  # Control steps of every shortened episode; short_env gives `custom` 3 targets.
 # Every task on every registered robot: ALL_TASKS, plus the user's `custom` task.
@@ -111,8 +113,11 @@ def test_the_same_seeds_on_a_new_environment_repeat_the_episode(robot, task):
       np.testing.assert_array_equal(first[name], second[name])
 
 
+SHAPES = tuple(task for task in suite.TASKS if suite.describe(task).reference)  # Of references.
+
+
 @pytest.mark.parametrize("robot", robots.REGISTERED_ROBOTS)
-@pytest.mark.parametrize("shape", references.SHAPES)
+@pytest.mark.parametrize("shape", SHAPES)
 def test_every_reference_is_reachable(robot, shape):
   """Replaying a reference's generating actions from rest reproduces its poses exactly."""
   reference = references.reference(robots.make(robot), shape, length=4)
@@ -149,9 +154,7 @@ def test_bend_amplitude_stops_early_at_the_answer_of_the_whole_grid(cores, monke
 
 def test_reference_shapes_differ_and_stay_in_unit_actuation():
   arm = robots.make("pneumatic-433")
-  actions = {
-    shape: references.pattern_actions(arm, shape, 50, amplitude=0.5) for shape in references.SHAPES
-  }
+  actions = {shape: references.pattern_actions(arm, shape, 50, amplitude=0.5) for shape in SHAPES}
   for shape, action in actions.items():
     assert action.shape == (50, arm.action_dim)
     assert np.all(np.abs(action) <= 1.0), shape
@@ -358,10 +361,51 @@ def test_bad_arguments_get_one_line_errors(call, message):
 
 
 def test_registry_lists():
-  assert set(suite.TASKS) == {"babbling", "circle", "rectangle", "spiral", "reach", "custom"}
-  assert len(suite.ALL_TASKS) == len(robots.REGISTERED_ROBOTS) * 5
+  needs_input = [task for task in suite.TASKS if "user" in suite.describe(task).tags]
+  assert needs_input == ["custom"]
+  assert suite.ALL_TASKS == tuple(
+    (robot, task)
+    for robot in robots.REGISTERED_ROBOTS
+    for task in suite.TASKS
+    if task not in needs_input
+  )
   assert set(suite.BENCHMARKING) <= set(suite.ALL_TASKS)
   assert ("tendon-3", "spiral") in suite.BENCHMARKING
+
+
+def test_a_tracking_task_registered_from_outside_runs_on_every_robot(figure_eight):
+  # One decorated function (example_task.register_figure_eight) makes a task like the built-in
+  # ones: listed, benchmarked, and loaded and run on every registered robot. (Alone, the test
+  # first calibrates every robot's bend amplitude, as the file's other tests do: 10 to 30 s.)
+  assert suite.TASKS[-1] == figure_eight and ("tendon-3", figure_eight) in suite.BENCHMARKING
+  assert suite.describe(figure_eight).tags == ("benchmarking", "tracking")
+  assert suite.length_options(figure_eight, SHORT_STEPS) == {"length": SHORT_STEPS}
+  for robot in robots.REGISTERED_ROBOTS:
+    observations, rewards = run_episode(short_env(robot, figure_eight, seed=1), seed=2)
+    assert len(rewards) == SHORT_STEPS and all(0.0 <= reward <= 1.0 for reward in rewards)
+    reference = references.reference(robots.make(robot), figure_eight, SHORT_STEPS)  # Cached.
+    np.testing.assert_array_equal(observations[0]["target"], reference.targets[0])
+    assert reference.actions.shape == (SHORT_STEPS, robots.make(robot).action_dim)
+
+
+def test_a_shape_s_cached_references_depend_on_its_own_parameters_only(
+  restored_tasks, monkeypatch, tmp_path
+):
+  monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
+  arm = robots.make("tendon-1")
+  circle = references.reference(arm, "circle", length=3)
+  twice = example_task.register_figure_eight(laps=2)
+  once = references.reference(arm, twice, length=3)
+  del registry._TASKS[twice]  # restored_tasks restores the registry after the test.
+  thrice = references.reference(arm, example_task.register_figure_eight(laps=3), length=3)
+  assert not np.array_equal(once.poses, thrice.poses)
+  assert len(list((tmp_path / references.FOLDER).glob("*.npz"))) == 3  # Circle and two eights.
+
+  def must_not_simulate(*args, **kwargs):
+    raise AssertionError("a cached reference was simulated again")
+
+  monkeypatch.setattr(recorder.PoseRecorder, "record", must_not_simulate)
+  np.testing.assert_array_equal(references.reference(arm, "circle", length=3).poses, circle.poses)
 
 
 BAD_SEEDS = [2**32, 2**70, -1, "x", 1.5, True]

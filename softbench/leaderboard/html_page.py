@@ -251,12 +251,16 @@ def _winner_boards(views: tuple[overview.Overview, ...], linked: bool = True) ->
 def _aggregate_board(view: aggregate.View) -> Board:
   rows = []
   for found in view.aggregates:
+    runs = sum(len(task) for task in found.runs)
+    if found.missing:  # No IQM that compares.
+      rows.append((Cell(found.agent), Cell(str(runs), runs), Cell(found.missing_text), Cell("-")))
+      continue
     median = float(np.median(np.concatenate(found.runs)))
     low, high = found.interval
     rows.append(
       (
         Cell(found.agent),
-        Cell(str(sum(len(task) for task in found.runs)), sum(len(task) for task in found.runs)),
+        Cell(str(runs), runs),
         Cell(
           ranking.number(found.iqm),
           found.iqm,
@@ -269,7 +273,7 @@ def _aggregate_board(view: aggregate.View) -> Board:
   columns = (("agent", False), ("runs", True), ("IQM", True), ("median", True))
   estimates = [
     (found.agent, found.agent, ranking.Estimate(found.iqm, None, found.interval))
-    for found in view.aggregates
+    for found in view.complete
   ]
   chart = log_chart.chart(
     estimates,

@@ -7,14 +7,17 @@ for every robot; ``ALL_TASKS`` lists the (robot, task) pairs of the registered r
 when it gives only part of the target, ``trajectories.Given``) and is in neither list, as it
 needs one.
 
+A task is a ``TaskEntry`` in the registry (``registry``): ``register`` adds one, and
+``tracking_task`` a tracking task from the one function that traces its reference
+(``shapes``: ``babbling``, ``circle``, ``rectangle``, ``spiral``). ``TASKS``, ``ALL_TASKS`` and
+``BENCHMARKING`` are read from the registry on every access, so they include later registrations.
+
 One control step lasts the robot's control period (``robot.control_timestep``): 1 s for the
 tendon arms (1 Hz, the paper's simulator; tendon-5, the slowest, settles in 0.72 s) and 0.2 s
 for the pneumatic arm (5 Hz, as on the real robot).
 """
 
-import collections
 import inspect
-from typing import Callable
 
 from dm_control.rl import control
 import numpy as np
@@ -24,36 +27,16 @@ from softbench.data import seeding
 from softbench.robots import physics as arm_physics
 from softbench.suite import base
 from softbench.suite import reach
-from softbench.suite import references
+from softbench.suite import registry
+from softbench.suite import shapes  # noqa: F401  Registers babbling, circle, rectangle, spiral.
 from softbench.suite import tracking
 from softbench.suite import trajectories
 
-TaskEntry = collections.namedtuple(
-  "TaskEntry",
-  ["build", "tags", "description", "paper_robot", "length_option", "partial_targets"],
-  defaults=(None,),
-)
-"""A task of the suite: ``build(robot, random=..., **options)``, its tags, a one-line description,
-the robot it runs on in the paper (the default of ``softbench run --robot``), the option that
-sets its episode length (None: the user's trajectory does) and ``partial_targets(robot,
-options)``, whether its targets leave part of the arm's pose out (None: they never do)."""
-
-
-def _reference_task(shape: str) -> Callable[..., base.SoftArmTask]:
-  def build(
-    robot,
-    length: int = references.REFERENCE_LENGTH,
-    initial_actuation: float = base.INITIAL_ACTUATION,
-    random=None,
-  ) -> base.SoftArmTask:
-    return tracking.Tracking(
-      robot,
-      references.reference(robot, shape, length).targets,
-      initial_actuation=initial_actuation,
-      random=random,
-    )
-
-  return build
+TaskEntry = registry.TaskEntry
+describe = registry.describe
+on_register = registry.on_register
+register = registry.register
+tracking_task = tracking.tracking_task
 
 
 def _custom_task(
@@ -77,107 +60,45 @@ def _custom_task(
   )
 
 
-# The paper runs its Exp2S tracking on the tendon arm and its reaching on the pneumatic arm.
-_TASKS = {
-  "babbling": TaskEntry(
-    _reference_task("babbling"),
-    ("benchmarking", "tracking"),
-    "follow held-out poses produced by random actuation",
-    "tendon-3",
-    "length",
+# After the tracking shapes (the import of ``shapes``), in the order the tables list tasks.
+register(
+  "reach",
+  TaskEntry(
+    build=reach.Reach,
+    tags=("benchmarking",),
+    description="bring one module's tip to a virtual point (position only)",
+    paper_robot="pneumatic-433",  # The paper reaches with its real, pneumatic arm.
+    length_option="steps",
+    partial_targets=lambda robot, options: True,
   ),
-  "circle": TaskEntry(
-    _reference_task("circle"),
-    ("benchmarking", "tracking"),
-    "follow a circle traced in actuation space",
-    "tendon-3",
-    "length",
-  ),
-  "rectangle": TaskEntry(
-    _reference_task("rectangle"),
-    ("benchmarking", "tracking"),
-    "follow a rectangle traced in actuation space",
-    "tendon-3",
-    "length",
-  ),
-  "spiral": TaskEntry(
-    _reference_task("spiral"),
-    ("benchmarking", "tracking"),
-    "follow a growing spiral traced in actuation space",
-    "tendon-3",
-    "length",
-  ),
-  "reach": TaskEntry(
-    reach.Reach,
-    ("benchmarking",),
-    "bring one module's tip to a virtual point (position only)",
-    "pneumatic-433",
-    "steps",
-    lambda robot, options: True,
-  ),
-  "custom": TaskEntry(
-    _custom_task,
-    ("tracking", "user"),
-    "follow your own trajectory (.npy or .csv, one target per row)",
-    "tendon-3",
-    None,
-    lambda robot, options: (
+)
+register(
+  "custom",
+  TaskEntry(
+    build=_custom_task,
+    tags=("tracking", "user"),
+    description="follow your own trajectory (.npy or .csv, one target per row)",
+    paper_robot="tendon-3",
+    length_option=None,
+    partial_targets=lambda robot, options: (
       trajectories.as_given(options.get("given"), robot)
       not in (None, trajectories.Given.whole(robot))
     ),
   ),
+)
+
+_LISTS = {
+  "TASKS": registry.names,
+  "ALL_TASKS": registry.pairs,
+  "BENCHMARKING": lambda: registry.pairs("benchmarking"),
 }
-TASKS = tuple(_TASKS)
 
 
-def _pairs() -> tuple[tuple[tuple[str, str], ...], tuple[tuple[str, str], ...]]:
-  """Every (robot, task) pair of the registered robots and the tasks that need no user input, and
-  those of them tagged ``benchmarking``."""
-  every = tuple(
-    (robot, task)
-    for robot in robots.REGISTERED_ROBOTS
-    for task in TASKS
-    if "user" not in _TASKS[task].tags
-  )
-  return every, tuple(pair for pair in every if "benchmarking" in _TASKS[pair[1]].tags)
-
-
-ALL_TASKS, BENCHMARKING = _pairs()
-
-
-_LISTENERS: list[Callable[[str], None]] = []  # Called with each task registered later.
-
-
-def on_register(listener: Callable[[str], None]) -> None:
-  """Calls ``listener(name)`` for every task that ``register`` adds from now on (so that
-  ``softbench.envs`` gives it Gymnasium ids, whichever of the two is imported first)."""
-  _LISTENERS.append(listener)
-
-
-def register(name: str, entry: TaskEntry) -> None:
-  """Adds task ``name`` to the suite (``TASKS``, ``ALL_TASKS`` and ``BENCHMARKING`` are rebound
-  to include it): ``entry.build(robot, random=..., **options)`` returns a ``SoftArmTask``.
-
-  Raises:
-    ValueError: the name is taken or malformed, or the paper robot is unknown (one line).
-  """
-  global TASKS, ALL_TASKS, BENCHMARKING
-  if not isinstance(name, str) or not name or name != name.strip().lower() or " " in name:
-    raise ValueError(f"task names are lowercase words without spaces, got {name!r}")
-  if name in _TASKS:
-    raise ValueError(f"task {name!r} is registered already")
-  robots.make(entry.paper_robot)
-  _TASKS[name] = entry
-  TASKS = tuple(_TASKS)
-  ALL_TASKS, BENCHMARKING = _pairs()
-  for listener in _LISTENERS:
-    listener(name)
-
-
-def describe(task: str) -> TaskEntry:
-  if task not in _TASKS:
-    raise ValueError(f"unknown task {task!r}; choose one of {', '.join(TASKS)}")
-  return _TASKS[task]
+def __getattr__(name: str):
+  """``TASKS`` (every task's name), ``ALL_TASKS`` and ``BENCHMARKING``, as registered now."""
+  if name in _LISTS:
+    return _LISTS[name]()
+  raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def length_options(task: str, steps: int | None) -> dict:
@@ -249,5 +170,7 @@ __all__ = [
   "gives_whole_targets",
   "length_options",
   "load",
+  "on_register",
   "register",
+  "tracking_task",
 ]

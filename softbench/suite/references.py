@@ -1,27 +1,26 @@
 """Reference trajectories that the robot can follow, because the robot itself traced them.
 
-Each reference drives the simulated arm from rest with an actuation pattern and records every
-module's pose after each control period (``PoseRecorder``). The patterns bend every module alike
-towards a point moving in the planar actuation space of ``SoftArm.planar_action``:
+A tracking task's reference drives the simulated arm from rest with the actions of its ``Shape``
+and records every module's pose after each control period (``PoseRecorder``). A planar shape bends
+every module alike towards a point moving in the planar actuation space of
+``SoftArm.planar_action``, in units of ``bend_amplitude`` (the actuation that bends the end
+effector by ``BEND_DEG``); any other shape gives the robot's actions itself. The shapes are the
+functions that ``suite.tracking_task`` registers (``softbench/suite/shapes.py``).
 
-- ``circle``: ``CIRCLE_TURNS`` turns of radius ``CIRCLE_RADIUS``;
-- ``rectangle``: ``RECTANGLE_LAPS`` laps of a rectangle of half sides ``RECTANGLE_HALF_SIDES``,
-  at constant speed along the perimeter;
-- ``spiral``: ``SPIRAL_TURNS`` turns whose radius grows linearly to ``SPIRAL_MAX_RADIUS``;
-- ``babbling``: uniform random actions from a seed stream that motor-babbling datasets never
-  use, so the poses are held out from every training set (the paper's "test babbling").
-
-References are cached under ``softbench_home()/references``, keyed by a hash of everything that
-generates them (the robot's MJCF included), with a content hash checked on every load; a damaged
-one is reported (``CorruptFileWarning``) and generated again. Processes sharing a data home
-generate each reference once: the others wait for it (``storage.found_or_made``). The generating
-actions are stored for replay checks; tasks show controllers only the poses.
+References are cached under ``softbench_home()/references``, keyed by a hash of the robot (its
+MJCF included), the length, the shape's name and its own parameters (and, for a planar shape, the
+calibration's), so that adding or changing one shape leaves every other shape's cached references
+valid; a content hash is checked on every load, and a damaged one is reported
+(``CorruptFileWarning``) and generated again. Processes sharing a data home generate each
+reference once: the others wait for it (``storage.found_or_made``). The generating actions are
+stored for replay checks; tasks show controllers only the poses.
 """
 
 from collections.abc import Callable
 import dataclasses
 import functools
 import hashlib
+import inspect
 import json
 import os
 import pathlib
@@ -33,44 +32,81 @@ from rich import console
 from softbench import progress
 from softbench import storage
 from softbench.data import dataset
-from softbench.data import seeding
 from softbench.robots import base
 from softbench.robots import recorder
+from softbench.suite import registry
 
 REFERENCE_LENGTH = 1000  # Target poses per reference (paper: 1,000 samples per trajectory).
 BEND_DEG = 60.0  # (deg) End-effector bend at one bend amplitude.
-CIRCLE_RADIUS = 0.8  # Bend amplitudes.
-CIRCLE_TURNS = 4
-RECTANGLE_HALF_SIDES = (0.9, 0.5)  # Bend amplitudes along x and y.
-RECTANGLE_LAPS = 4
-SPIRAL_TURNS = 5
-LEAD_IN = 0.05  # Fraction of the steps over which circle and rectangle grow from the centre.
 AMPLITUDE_GRID = np.linspace(0.05, 1.0, 20)  # Actuations tried when calibrating the amplitude.
 SETTLE_SECONDS = 3.0  # (s) Hold per calibration actuation; longer than any settling time.
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2  # 2: a shape's key holds its own parameters only (1: every shape's).
 FOLDER = "references"  # In the data home.
+_FIXED_ARGUMENTS = {True: ("length",), False: ("robot", "length")}  # Of a planar shape, of others.
 
 
-def _phases(length: int, cycles: float) -> np.ndarray:
-  """Phase in cycles of each control step; step t's target is reached after t + 1 actions."""
-  return cycles * np.arange(1, length + 1) / length
+@dataclasses.dataclass(frozen=True)
+class Shape:
+  """How a tracking task's reference is traced: ``trace(length, **parameters)`` gives (length, 2)
+  points of the planar actuation space in bend amplitudes (``planar``), else
+  ``trace(robot, length, **parameters)`` gives the robot's actions (length, action_dim) in
+  [-1, 1]. Its parameters are the defaults of its other arguments (numbers, strings, or lists
+  and tuples of them): the cache key of its references hashes them, and no other shape's."""
 
+  name: str
+  trace: Callable[..., np.ndarray]
+  planar: bool = True
 
-def _on_circle(radius: np.ndarray | float, phase: np.ndarray) -> np.ndarray:
-  angle = 2 * np.pi * phase
-  return np.stack([radius * np.cos(angle), radius * np.sin(angle)], axis=-1)
+  def __post_init__(self):
+    arguments = list(inspect.signature(self.trace).parameters.values())
+    fixed = _FIXED_ARGUMENTS[self.planar]
+    if tuple(argument.name for argument in arguments[: len(fixed)]) != fixed:
+      raise ValueError(
+        f"shape {self.name!r}: {self.trace.__name__} must take ({', '.join(fixed)}, ...) first"
+      )
+    for argument in arguments[len(fixed) :]:
+      if argument.default is inspect.Parameter.empty:
+        raise ValueError(f"shape {self.name!r}: parameter {argument.name!r} needs a default")
+    try:
+      json.dumps(self.parameters, allow_nan=False)
+    except (TypeError, ValueError) as error:
+      raise ValueError(
+        f"shape {self.name!r}: parameters must be numbers, strings or lists of them ({error})"
+      ) from None
 
+  @property
+  def parameters(self) -> dict:
+    """The defaults of ``trace``'s arguments after the robot and the length, by name."""
+    arguments = list(inspect.signature(self.trace).parameters.values())
+    return {
+      argument.name: argument.default
+      for argument in arguments[len(_FIXED_ARGUMENTS[self.planar]) :]
+    }
 
-def _on_rectangle(phase: np.ndarray) -> np.ndarray:
-  half_x, half_y = RECTANGLE_HALF_SIDES
-  corners = np.array(
-    [[half_x, -half_y], [half_x, half_y], [-half_x, half_y], [-half_x, -half_y], [half_x, -half_y]]
-  )
-  distance = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(corners, axis=0), axis=1))])
-  along = (phase % 1.0) * distance[-1]
-  return np.stack(
-    [np.interp(along, distance, corners[:, 0]), np.interp(along, distance, corners[:, 1])], axis=-1
-  )
+  def actions(self, robot: base.SoftArm, length: int, amplitude: float | None) -> np.ndarray:
+    """The actions (length, action_dim) that trace the shape on ``robot``; a planar shape's
+    points are scaled by ``amplitude`` (default ``bend_amplitude(robot)``).
+
+    Raises:
+      ValueError: ``trace`` gave an array of another shape, values that are not finite, or
+        actions out of [-1, 1] (one line).
+    """
+    if not self.planar:
+      actions = self._checked(self.trace(robot, length), (length, robot.action_dim))
+      if np.any(np.abs(actions) > 1.0):
+        raise ValueError(f"shape {self.name!r} gave actions out of [-1, 1]")
+      return actions
+    points = self._checked(self.trace(length), (length, 2))
+    amplitude = bend_amplitude(robot) if amplitude is None else amplitude
+    return robot.planar_action(amplitude * points)
+
+  def _checked(self, traced, expected: tuple[int, ...]) -> np.ndarray:
+    traced = np.asarray(traced, dtype=float)
+    if traced.shape != expected:
+      raise ValueError(f"shape {self.name!r} gave an array {traced.shape}, not {expected}")
+    if not np.all(np.isfinite(traced)):
+      raise ValueError(f"shape {self.name!r} gave NaN or infinite values")
+    return traced
 
 
 @functools.lru_cache(maxsize=None)
@@ -106,62 +142,25 @@ def bend_amplitude(robot: base.SoftArm) -> float:
   )
 
 
-def _lead_in(length: int) -> np.ndarray:
-  """(length, 1) factors that grow a path from the centre over its first ``LEAD_IN`` steps."""
-  return np.minimum(1.0, np.arange(1, length + 1) / (LEAD_IN * length))[:, None]
+def shape_named(name: str) -> Shape:
+  """The reference shape of tracking task ``name``.
 
-
-def _circle(length: int) -> np.ndarray:
-  return _lead_in(length) * _on_circle(CIRCLE_RADIUS, _phases(length, CIRCLE_TURNS))
-
-
-def _rectangle(length: int) -> np.ndarray:
-  return _lead_in(length) * _on_rectangle(_phases(length, RECTANGLE_LAPS))
-
-
-def _spiral(length: int) -> np.ndarray:
-  return _on_circle(_phases(length, 1.0), _phases(length, SPIRAL_TURNS))
-
-
-def _planar(path: Callable[[int], np.ndarray]) -> Callable[..., np.ndarray]:
-  """The actions of a path (length, 2) in the planar actuation space, in bend amplitudes."""
-
-  def actions(robot: base.SoftArm, length: int, amplitude: float | None) -> np.ndarray:
-    amplitude = bend_amplitude(robot) if amplitude is None else amplitude
-    return robot.planar_action(amplitude * path(length))
-
-  return actions
-
-
-def _babbling(robot: base.SoftArm, length: int, amplitude: float | None) -> np.ndarray:
-  del amplitude  # Uniform over the whole action range.
-  stream = seeding.rng(0, seeding.HELD_OUT_BABBLING_STREAM)
-  return stream.uniform(-1.0, 1.0, (length, robot.action_dim))
-
-
-_GENERATORS = {
-  "babbling": _babbling,
-  "circle": _planar(_circle),
-  "rectangle": _planar(_rectangle),
-  "spiral": _planar(_spiral),
-}
-"""Shape name -> ``generate(robot, length, amplitude) -> actions (length, action_dim)``; a new
-shape is a generator and one entry here."""
-SHAPES = tuple(_GENERATORS)
-
-
-def _check_shape(shape: str) -> None:
-  if shape not in _GENERATORS:
-    raise ValueError(f"unknown reference shape {shape!r}; choose one of {', '.join(SHAPES)}")
+  Raises:
+    ValueError: no tracking task of that name traces a reference (one line).
+  """
+  found = registry.describe(name).reference if name in registry.names() else None
+  if found is None:
+    shapes = [task for task in registry.names() if registry.describe(task).reference]
+    raise ValueError(f"unknown reference shape {name!r}; choose one of {', '.join(shapes)}")
+  return found
 
 
 def pattern_actions(
-  robot: base.SoftArm, shape: str, length: int = REFERENCE_LENGTH, amplitude: float | None = None
+  robot: base.SoftArm, name: str, length: int = REFERENCE_LENGTH, amplitude: float | None = None
 ) -> np.ndarray:
-  """The generating actions (length, action_dim) of reference ``shape``; ``amplitude`` is
-  ``bend_amplitude(robot)`` unless given."""
-  _check_shape(shape)
-  return _GENERATORS[shape](robot, length, amplitude)
+  """The generating actions (length, action_dim) of reference ``name``; a planar shape's
+  ``amplitude`` is ``bend_amplitude(robot)`` unless given."""
+  return shape_named(name).actions(robot, length, amplitude)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -179,20 +178,24 @@ class Reference:
     return self.poses[1:]
 
 
-def _config(robot: base.SoftArm, shape: str, length: int) -> dict:
-  return {
+def _config(robot: base.SoftArm, shape: Shape, length: int) -> dict:
+  """What a reference depends on, as its cache's description stores it: the robot, the length,
+  the shape's own parameters and, for a planar shape, the calibration of ``bend_amplitude``."""
+  config = {
     "format": FORMAT_VERSION,
     "robot": robot.name,
-    "shape": shape,
-    "length": length,
     "robot_xml_sha256": robot.physics_sha256(),
-    "bend_deg": BEND_DEG,
-    "amplitude_grid": AMPLITUDE_GRID.tolist(),
-    "lead_in": LEAD_IN,
-    "circle": [CIRCLE_RADIUS, CIRCLE_TURNS],
-    "rectangle": [*RECTANGLE_HALF_SIDES, RECTANGLE_LAPS],
-    "spiral": [SPIRAL_TURNS],
+    "length": length,
+    "shape": shape.name,
+    "parameters": shape.parameters,
   }
+  if shape.planar:
+    config["calibration"] = {
+      "bend_deg": BEND_DEG,
+      "amplitude_grid": AMPLITUDE_GRID.tolist(),
+      "settle_s": SETTLE_SECONDS,
+    }
+  return json.loads(json.dumps(config))  # Tuples as lists, as read back.
 
 
 def _load_cached(path, config: dict) -> Reference | None:
@@ -244,8 +247,7 @@ def reference(robot: base.SoftArm, shape: str, length: int = REFERENCE_LENGTH) -
   """The reference ``shape`` of ``robot``, from the cache or simulated (and then cached)."""
   if not (isinstance(length, int) and length >= 1):
     raise ValueError(f"reference length must be a positive integer, got {length!r}")
-  _check_shape(shape)
-  config = _config(robot, shape, length)
+  config = _config(robot, shape_named(shape), length)
   key = hashlib.sha256(json.dumps(config, sort_keys=True).encode()).hexdigest()[:12]
   path = storage.softbench_home() / FOLDER / f"{robot.name}-{shape}-n{length}-{key}.npz"
   return storage.found_or_made(
