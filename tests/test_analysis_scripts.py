@@ -20,6 +20,7 @@ from softbench.agents import learners
 from softbench.learning import inverse as inverse_training
 from softbench.robots import versions
 from softbench.runners import run
+from softbench.runners import run_settings
 
 ANALYSIS = pathlib.Path(__file__).parent.parent / "docs" / "analysis"
 
@@ -45,7 +46,7 @@ def _smpl_circle_record() -> dict:
   """`softbench run`'s record of SMPL on tendon-2's circle, tiny profile, seed 0: what the SMPL
   analysis scripts must reproduce with SMPL's own settings."""
   return run.execute(
-    run.settings("circle", "smpl", "tendon-2", seeds=1, profile="tiny"),
+    run_settings.settings("circle", "smpl", "tendon-2", seeds=1, profile="tiny"),
     show_progress=False,
     workers=1,
   )
@@ -92,7 +93,7 @@ def test_early_stopping_keeps_the_agent_softbench_run_trains(monkeypatch, capsys
   )
   assert set(scores) == {"best validation", "after epoch 1", "after epoch 2"}
   record = run.execute(
-    run.settings("circle", "lstm", "tendon-1", seeds=1, profile="tiny"),
+    run_settings.settings("circle", "lstm", "tendon-1", seeds=1, profile="tiny"),
     show_progress=False,
     workers=1,
   )

@@ -25,6 +25,7 @@ from softbench.learning import forward_models
 from softbench.learning import inverse as inverse_training
 from softbench.runners import evaluation
 from softbench.runners import run
+from softbench.runners import run_settings
 from softbench.suite import references
 
 ROBOT = "tendon-1"
@@ -65,8 +66,8 @@ def _forward() -> dict:
   return {name: tensor.numpy() for name, tensor in model.state_dict().items()}
 
 
-def _run_settings() -> run.RunSettings:
-  return run.settings("circle", "zero", ROBOT, 1, "tiny")
+def _run_settings() -> run_settings.RunSettings:
+  return run_settings.settings("circle", "zero", ROBOT, 1, "tiny")
 
 
 def _episode() -> dict:

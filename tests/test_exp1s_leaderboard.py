@@ -24,6 +24,7 @@ from softbench.leaderboard import html_page
 from softbench.records import exp1s as exp1s_records
 from softbench.runners import continual
 from softbench.runners import run
+from softbench.runners import run_settings
 
 
 def write_raw(record: dict, path: pathlib.Path, reseal: bool = True) -> pathlib.Path:
@@ -239,7 +240,7 @@ def run_record(tmp_path_factory) -> dict:
   """A 1-seed record of the zero agent on tendon-1 circle, as ``softbench run`` makes it."""
   with pytest.MonkeyPatch.context() as patch:
     patch.setenv("SOFTBENCH_HOME", str(tmp_path_factory.mktemp("exp1s_board_home")))
-    settings = run.settings("circle", "zero", "tendon-1", seeds=1, profile="tiny")
+    settings = run_settings.settings("circle", "zero", "tendon-1", seeds=1, profile="tiny")
     return run.execute(settings, show_progress=False, workers=1)
 
 

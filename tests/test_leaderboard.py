@@ -31,6 +31,7 @@ from softbench.leaderboard import ranking
 from softbench.leaderboard import verified
 from softbench.leaderboard import winners
 from softbench.runners import run
+from softbench.runners import run_settings
 
 
 @pytest.fixture(scope="module")
@@ -38,7 +39,7 @@ def real_record(tmp_path_factory) -> dict:
   """A 2-seed record of the zero agent on tendon-1 circle, as ``softbench run`` makes it."""
   with pytest.MonkeyPatch.context() as patch:
     patch.setenv("SOFTBENCH_HOME", str(tmp_path_factory.mktemp("leaderboard_home")))
-    settings = run.settings("circle", "zero", "tendon-1", seeds=2, profile="tiny")
+    settings = run_settings.settings("circle", "zero", "tendon-1", seeds=2, profile="tiny")
     return run.execute(settings, show_progress=False, workers=1)
 
 

@@ -28,6 +28,7 @@ from softbench.episodes import snapshots as episode_snapshots
 from softbench.runners import continual
 from softbench.runners import retrain
 from softbench.runners import run
+from softbench.runners import run_settings
 from softbench.runners import saving
 from softbench.suite import references
 from softbench.sweep import grid as sweep_grid
@@ -123,7 +124,7 @@ def test_an_interrupt_once_the_record_is_written_leaves_a_complete_run(
     f"softbench: interrupted once the run was complete: its result record is {path} ("
   )
   assert records.read(path)["seeds"] == 1
-  settings = run.settings("circle", "zero", "tendon-1", 1, "tiny")
+  settings = run_settings.settings("circle", "zero", "tendon-1", 1, "tiny")
   assert not episode_snapshots.folder(settings).exists()  # Nothing left to resume from.
 
 

@@ -16,6 +16,7 @@ from softbench.agents import reference
 from softbench.episodes import snapshots as episode_snapshots
 from softbench.runners import evaluation
 from softbench.runners import run
+from softbench.runners import run_settings
 
 SEEDS = 3
 
@@ -25,8 +26,8 @@ def data_home(tmp_path, monkeypatch):
   monkeypatch.setenv("SOFTBENCH_HOME", str(tmp_path))
 
 
-def tiny_run(agent: str = "random") -> run.RunSettings:
-  return run.settings("circle", agent, "tendon-1", seeds=SEEDS, profile="tiny")
+def tiny_run(agent: str = "random") -> run_settings.RunSettings:
+  return run_settings.settings("circle", agent, "tendon-1", seeds=SEEDS, profile="tiny")
 
 
 def interrupted_at(seed: int, monkeypatch) -> list[int]:
@@ -112,10 +113,10 @@ def test_other_settings_never_reuse_saved_seeds(monkeypatch):
     for settings in (
       tiny_run(),
       tiny_run("zero"),
-      run.settings(
+      run_settings.settings(
         "circle", "random", "tendon-1", seeds=SEEDS, profile="tiny", eval_mode="open-loop"
       ),
-      run.settings("circle", "random", "tendon-2", seeds=SEEDS, profile="tiny"),
+      run_settings.settings("circle", "random", "tendon-2", seeds=SEEDS, profile="tiny"),
     )
   }
   assert len(folders) == 4
@@ -209,7 +210,7 @@ def test_an_interrupted_episode_goes_on_mid_way_to_the_same_episode(monkeypatch,
 
 
 def test_a_damaged_unfinished_episode_starts_again(monkeypatch):
-  settings = run.settings("babbling", "reference", "tendon-1", seeds=1, profile="tiny")
+  settings = run_settings.settings("babbling", "reference", "tendon-1", seeds=1, profile="tiny")
   monkeypatch.setattr(evaluation, "KEEP_INTERVAL_S", 0.0)
   expected = run.fresh_seed(settings, 0)[1]
   interrupt_at = [3]

@@ -7,6 +7,7 @@ import dataclasses
 from softbench.learning import protocols
 from softbench.runners import continual
 from softbench.runners import run
+from softbench.runners import run_settings
 
 EXP1S_STAGES = ("tendon-1", "tendon-2")  # Exp1S on these arms (of whichever family), not 1 .. 5.
 BROKEN = "an evaluation broken on purpose"  # The error of ``break_zero_evaluations``.
@@ -24,7 +25,7 @@ def break_zero_evaluations() -> None:
   """Every seed of the zero agent raises (``run.fresh_seed``, which a sweep's evaluation calls)."""
   fresh_seed = run.fresh_seed
 
-  def broken_for_zero(settings: run.RunSettings, seed: int, show_progress: bool = False):
+  def broken_for_zero(settings: run_settings.RunSettings, seed: int, show_progress: bool = False):
     if settings.agent == "zero":
       raise RuntimeError(BROKEN)
     return fresh_seed(settings, seed, show_progress)

@@ -24,6 +24,7 @@ from softbench.agents import hyperparameters
 from softbench.agents import learned
 from softbench.learning import inverse as inverse_training
 from softbench.runners import run
+from softbench.runners import run_settings
 from softbench.tuning import study
 
 
@@ -74,7 +75,7 @@ def main() -> None:
   )
   best = f"best validation (epoch {result.best_epoch + 1}, what early stopping keeps)"
   kept = {best: copy.deepcopy(inverse.state_dict()), **kept}
-  settings = run.settings(args.task, args.agent, args.robot, seeds=1, profile=args.profile)
+  settings = run_settings.settings(args.task, args.agent, args.robot, seeds=1, profile=args.profile)
   for label, state in kept.items():
     inverse.load_state_dict(state)
     inverse.eval()

@@ -29,6 +29,7 @@ from softbench.agents import hyperparameters
 from softbench.agents import learned
 from softbench.learning import inverse as inverse_training
 from softbench.runners import run
+from softbench.runners import run_settings
 
 VIEWS = {
   "own": data.View.module,  # Module k's forward model reads modules 1..k's actuation.
@@ -47,7 +48,7 @@ def main() -> None:
 
   arm, profile = robots.make(args.robot), profiles.get(args.profile)
   params = hyperparameters.values("smpl", arm.name)
-  settings = run.settings(args.task, "smpl", args.robot, seeds=1, profile=args.profile)
+  settings = run_settings.settings(args.task, "smpl", args.robot, seeds=1, profile=args.profile)
   for seed in args.seeds:
     for name in args.views:
       views = [VIEWS[name](arm, module) for module in range(1, arm.num_modules + 1)]

@@ -36,6 +36,7 @@ from softbench.agents import learned
 from softbench.agents import learners
 from softbench.learning import inverse as inverse_training
 from softbench.runners import run
+from softbench.runners import run_settings
 
 
 def check_preceding_is_proximal(windows: list) -> None:
@@ -80,7 +81,7 @@ def main() -> None:
   arm, profile = robots.make(args.robot), profiles.get(args.profile)
   views = learners.views(arm, per_module=True)
   params = hyperparameters.values("smpl", arm.name)
-  settings = run.settings(args.task, "smpl", args.robot, seeds=1, profile=args.profile)
+  settings = run_settings.settings(args.task, "smpl", args.robot, seeds=1, profile=args.profile)
   device = training.default_device()
   for seed in args.seeds:
     windows, forwards = inverse_training.trained_forward_models(arm, views, seed, profile)

@@ -25,6 +25,7 @@ from softbench.agents import learned
 from softbench.agents import learners
 from softbench.learning import inverse as inverse_training
 from softbench.runners import run
+from softbench.runners import run_settings
 
 
 def _columns(text: str) -> tuple[int, int]:
@@ -45,7 +46,7 @@ def main() -> None:
   views = learners.views(arm, per_module=True)
   windows, forwards = inverse_training.trained_forward_models(arm, views, args.seed, profile)
   params = hyperparameters.values("smpl", arm.name)
-  settings = run.settings(args.task, "smpl", args.robot, seeds=1, profile=args.profile)
+  settings = run_settings.settings(args.task, "smpl", args.robot, seeds=1, profile=args.profile)
   for width, layers in args.columns:
 
     class Columns(progressive.ProgressiveLSTM):

@@ -28,11 +28,12 @@ def handle(args: argparse.Namespace) -> None:
   from softbench.data import seeding
   from softbench.rendering import options as video_options
   from softbench.runners import run as run_module
+  from softbench.runners import run_settings
 
   request = arguments.video_request(args, args.out)
   seed = video_options.parse_number("seed", args.seed, int)
   seeding.check_seed(seed)
-  settings = run_module.settings(
+  settings = run_settings.settings(
     args.task, args.agent, args.robot, 1, args.profile, args.eval, args.trajectory, given=args.given
   )
   run_module.render_seed(settings, seed, request)

@@ -100,6 +100,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def handle(args: argparse.Namespace) -> None:
   from softbench.data import dataset
   from softbench.runners import run as run_module
+  from softbench.runners import run_settings
   from softbench.runners import saving
 
   video_flags = arguments.flags_given(args, arguments.VIDEO_OPTIONS)
@@ -116,7 +117,7 @@ def handle(args: argparse.Namespace) -> None:
     raise ValueError("--family goes with --protocol exp1s; a task's robot is --robot")
   if args.task is None:
     raise ValueError("softbench run needs --task TASK (or --protocol exp1s)")
-  settings = run_module.settings(
+  settings = run_settings.settings(
     args.task,
     args.agent,
     args.robot,

@@ -60,7 +60,7 @@ def keyed_folder(name: str, settings) -> pathlib.Path:
 
 
 def folder(run) -> pathlib.Path:
-  """Where the finished seeds of ``run`` (a ``softbench.runners.run.RunSettings``) are kept."""
+  """Where the finished seeds of ``run`` (a ``runners.run_settings.RunSettings``) are kept."""
   trajectory = None  # A file edited under the same name differs; an unreadable one fails later,
   if run.trajectory:  # with its own error.
     try:

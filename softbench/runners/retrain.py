@@ -32,6 +32,7 @@ from softbench.learning import inverse as inverse_training
 from softbench.records import provenance
 from softbench.robots import faults as fault_model
 from softbench.runners import run as run_module
+from softbench.runners import run_settings
 
 DEFAULT_TASK = "spiral"
 DEFAULT_BASELINE = "lstm"
@@ -46,7 +47,7 @@ CONDITIONS = (
 
 @dataclasses.dataclass(frozen=True)
 class RetrainSettings:
-  run: run_module.RunSettings  # The smpl agent's run, faults included.
+  run: run_settings.RunSettings  # The smpl agent's run, faults included.
   baseline: str
 
   @property
@@ -80,7 +81,7 @@ def settings(
     )
   if not faults:
     raise ValueError(f"retrain needs a fault: --fault {fault_model.FAULT_FORMAT}")
-  run = run_module.settings(task, agent, robot, seeds, profile, faults=tuple(faults))
+  run = run_settings.settings(task, agent, robot, seeds, profile, faults=tuple(faults))
   adaptation.faulty_module(robots.make(run.robot).with_faults(run.faults))
   return RetrainSettings(run, baseline)
 
@@ -94,7 +95,7 @@ def _timed_baseline(
   path = learned.checkpoint_path(settings.baseline, faulty, seed, profile, per_module=False)
   cached = _file_identity(path)
   started = time.perf_counter()
-  acting = run_module.acting(settings.run)
+  acting = run_settings.acting(settings.run)
   agent = agents.make(settings.baseline, faulty, seed, profile, show_progress, acting)
   trained_now = _file_identity(path) != cached
   if trained_now:
@@ -118,7 +119,7 @@ def _seed(settings: RetrainSettings, seed: int, show_progress: bool) -> dict:
   healthy = robots.make(run.robot)
   faulty = healthy.with_faults(run.faults)
   smpl = agents.make(
-    RETRAINED_AGENT, healthy, seed, run.profile, show_progress, run_module.acting(run)
+    RETRAINED_AGENT, healthy, seed, run.profile, show_progress, run_settings.acting(run)
   )
   before, scored = run_module.evaluate(smpl, healthy, run, seed, show_progress)
   under, _ = run_module.evaluate(smpl, faulty, run, seed, show_progress)

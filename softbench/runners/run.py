@@ -22,30 +22,24 @@ from softbench import agents
 from softbench import data
 from softbench import episodes
 from softbench import metrics
-from softbench import profiles
 from softbench import records
 from softbench import robots
 from softbench import suite
 from softbench import zoo
 from softbench.agents import learned
-from softbench.data import dataset
 from softbench.episodes import snapshots as episode_snapshots
 from softbench.learning import inverse as inverse_training
-from softbench.records import fields
 from softbench.records import provenance
 from softbench.rendering import options as video_options
 from softbench.rendering import replay
 from softbench.rendering import video
 from softbench.robots import faults as fault_model
-from softbench.runners import adaptive as adaptive_activation
 from softbench.runners import evaluation
 from softbench.runners import parallel_seeds
+from softbench.runners import run_settings
 from softbench.runners import saving
-from softbench.runners.adaptive import experiment as adaptive_experiment
 from softbench.runners.adaptive import report as adaptive_report
 from softbench.runners.adaptive import runner as adaptive_runner
-from softbench.suite import reach
-from softbench.suite import trajectories
 
 METRICS = (
   ("position_mm", "position (mm)"),
@@ -57,162 +51,6 @@ RECORD_VERSION = records.VERSION
 
 
 @dataclasses.dataclass(frozen=True)
-class RunSettings:
-  task: str
-  agent: str
-  robot: str
-  seeds: int
-  profile: profiles.Profile
-  eval_mode: str
-  trajectory: str | None = None
-  module: int | None = None  # The reaching module (task reach); None: the task's default.
-  adaptive: bool = False
-  targets: int | None = None  # Virtual targets of an adaptive run.
-  helpers: str | None = None  # How a learned agent completes partial targets (helper_targets of
-  # LearnedAgent); None: the task gives whole targets, or the agent does not learn from babbling.
-  faults: tuple[fault_model.Fault, ...] = ()
-  given: str | None = None  # The part of a custom trajectory's targets its file gives (``Given``).
-
-
-def settings(
-  task: str,
-  agent: str,
-  robot: str | None = None,
-  seeds: int | None = None,
-  profile: str = profiles.DEFAULT_PROFILE,
-  eval_mode: str = "physics",
-  trajectory: str | None = None,
-  module: int | None = None,
-  adaptive: bool = False,
-  targets: int | None = None,
-  helpers: str | None = None,
-  faults: tuple[str, ...] = (),
-  given: str | None = None,
-) -> RunSettings:
-  """Checked settings, with the defaults filled in; ``faults`` as ``MODULE:ACTUATOR:GAIN`` text,
-  ``given`` as ``suite.trajectories.Given`` text.
-
-  Raises:
-    ValueError: unknown task, agent, robot, profile or eval mode, seeds outside 1 ..
-      ``profiles.MAX_SEEDS``, a trajectory
-      without the custom task or the custom task without one, an unreadable or malformed
-      trajectory file, a module with another task than reach or out of range, adaptive with
-      another task than reach, a non-learned agent or more than one seed, targets without
-      adaptive, targets < 1, unknown helpers or helpers where nothing is completed, a malformed
-      fault or one that names no actuator of the robot, ``given`` without a trajectory or
-      malformed (one line).
-  """
-  suite.describe(task)
-  agents.describe(agent)
-  chosen = profiles.get(profile)
-  robot = robot or suite.describe(task).paper_robot
-  parsed_faults = tuple(fault_model.parse(text) for text in faults)
-  robots.make(robot).with_faults(parsed_faults)
-  _check_adaptive(task, agent, robot, seeds, module, adaptive, targets)
-  if adaptive and parsed_faults:
-    raise ValueError("--fault and --adaptive do not go together yet")
-  seeds = (1 if adaptive else chosen.seeds) if seeds is None else seeds
-  dataset.check_count("seeds", seeds, profiles.MAX_SEEDS)
-  if eval_mode not in fields.ERROR_SOURCES:
-    raise ValueError(
-      f"unknown eval mode {eval_mode!r}; choose one of {', '.join(fields.ERROR_SOURCES)}"
-    )
-  if (trajectory is None) == (task == "custom"):
-    raise ValueError("--trajectory goes with --task custom, and --task custom needs one")
-  if given is not None and trajectory is None:
-    raise ValueError("--given goes with --task custom and its --trajectory")
-  if given is not None:
-    given = trajectories.Given.parse(given, robots.make(robot)).text
-  if trajectory is not None:  # Read now: a bad file is refused before any collection or training.
-    trajectories.load_trajectory(trajectory, robots.make(robot), given)
-  if adaptive:
-    targets = adaptive_activation.DEFAULT_TARGETS if targets is None else targets
-  run = RunSettings(
-    task,
-    agent,
-    robot,
-    seeds,
-    chosen,
-    eval_mode,
-    None if trajectory is None else str(trajectory),
-    module,
-    adaptive,
-    targets,
-    None,
-    parsed_faults,
-    given,
-  )
-  return dataclasses.replace(run, helpers=_helpers(run, helpers))
-
-
-def _check_adaptive(
-  task: str,
-  agent: str,
-  robot: str,
-  seeds: int | None,
-  module: int | None,
-  adaptive: bool,
-  targets: int | None,
-) -> None:
-  """The checks of ``--module``, ``--adaptive`` and ``--targets``."""
-  if module is not None and task != "reach":
-    raise ValueError("--module goes with --task reach")
-  if module is not None:
-    reach.check_module(robots.make(robot), module)
-  if adaptive and task != "reach":
-    raise ValueError(f"--adaptive goes with --task reach, not {task!r}: it reaches a point")
-  if adaptive and agents.learner(agent) is None:
-    raise ValueError(
-      f"--adaptive needs an agent trained on babbling "
-      f"({', '.join(agents.babbling_learners())}), not {agent!r}"
-    )
-  if adaptive and seeds not in (None, 1):
-    raise ValueError("--adaptive uses one trained agent (seed 0); vary --targets, not --seeds")
-  if targets is not None and not adaptive:
-    raise ValueError("--targets goes with --adaptive")
-  if targets is not None:
-    dataset.check_count("targets", targets, adaptive_activation.MAX_TARGETS)
-
-
-def _helpers(run: RunSettings, helpers: str | None) -> str | None:
-  """How ``run``'s agent completes its task's partial targets: ``helpers``, or by default
-  ``learned.DEFAULT_HELPER_TARGETS``; None where nothing is completed (whole targets, or an
-  agent that does not learn from babbling).
-
-  Raises:
-    ValueError: unknown ``helpers``, or ``helpers`` where nothing is completed (one line).
-  """
-  if helpers is not None:
-    adaptive_experiment.check_helpers(helpers)
-  if suite.gives_whole_targets(run.robot, run.task, **task_options(run)):
-    if helpers is not None:
-      raise ValueError(f"--helpers completes partial targets; task {run.task!r} gives whole ones")
-    return None
-  if agents.learner(run.agent) is None:
-    if helpers is not None:
-      raise ValueError(
-        f"--helpers goes with an agent trained on babbling "
-        f"({', '.join(agents.babbling_learners())}), not {run.agent!r}"
-      )
-    return None
-  return learned.DEFAULT_HELPER_TARGETS if helpers is None else helpers
-
-
-def acting(run: RunSettings) -> learned.Acting:
-  """How ``run``'s agent acts, if it is trained on babbling: its eval mode and helper targets."""
-  return learned.Acting(run.eval_mode, run.helpers or learned.DEFAULT_HELPER_TARGETS)
-
-
-def task_options(run: RunSettings) -> dict:
-  """The options ``suite.load`` gets for ``run``'s task (episode length, trajectory and the
-  part of it given)."""
-  if run.task == "custom":
-    return {"trajectory": run.trajectory, **({} if run.given is None else {"given": run.given})}
-  options = {} if run.module is None else {"module": run.module}
-  return {**options, **suite.length_options(run.task, run.profile.episode_length)}
-
-
-@dataclasses.dataclass(frozen=True)
 class VideoRequest:
   """An MP4 of seed 0's episode to render once the record is safe (``--video``)."""
 
@@ -221,21 +59,21 @@ class VideoRequest:
 
 
 def write_video(
-  run: RunSettings, seed: int, episode: episodes.Episode, request: VideoRequest
+  run: run_settings.RunSettings, seed: int, episode: episodes.Episode, request: VideoRequest
 ) -> None:
   """Renders ``episode`` (seed ``seed`` of ``run``) as ``request`` asks; prints what it wrote."""
   stats = video.render(replay_of(run, seed, episode), request.path, request.options, True)
   print(stats.describe(request.options))
 
 
-def render_seed(run: RunSettings, seed: int, request: VideoRequest) -> None:
+def render_seed(run: run_settings.RunSettings, seed: int, request: VideoRequest) -> None:
   """``softbench render``: trains (or reuses) seed ``seed``'s agent, runs its episode with a
   progress bar and renders it as ``request`` asks."""
   write_video(run, seed, seed_episode(run, seed, show_progress=True), request)
 
 
 def finish(
-  run: RunSettings,
+  run: run_settings.RunSettings,
   record: dict,
   files: list[pathlib.Path],
   episodes_run: list[episodes.Episode],
@@ -258,14 +96,14 @@ def finish(
     saving.link_video(record, files, video_request.path)
 
 
-def replay_of(run: RunSettings, seed: int, episode: episodes.Episode) -> replay.Replay:
+def replay_of(run: run_settings.RunSettings, seed: int, episode: episodes.Episode) -> replay.Replay:
   """The replay of ``episode``, seed ``seed`` of ``run``, for videos."""
   feedback = "" if run.eval_mode == "physics" else f", eval {run.eval_mode}"
   return replay.Replay(
     robots.make(run.robot),
     run.task,
     seed,
-    task_options(run),
+    run_settings.task_options(run),
     episode,
     f"{run.agent} on {run.task} ({run.robot}) seed {seed}, {run.profile.name} profile{feedback}",
   )
@@ -288,16 +126,18 @@ def _seed_scores(score: metrics.TrackingScore) -> dict:
 def episode_on(
   agent: agents.Agent,
   arm: robots.SoftArm,
-  run: RunSettings,
+  run: run_settings.RunSettings,
   seed: int,
   show_progress: bool = False,
   unfinished: pathlib.Path | None = None,
 ) -> episodes.Episode:
   """One episode of ``run``'s task (environment seed ``seed``) by ``agent`` on ``arm``, which may
   be a faulty robot; kept while it runs at ``unfinished`` (``evaluation.run_episode``)."""
-  if isinstance(agent, learned.LearnedAgent) and agent.acting != acting(run):
-    raise ValueError(f"this agent acts as {agent.acting}, but the run asks for {acting(run)}")
-  env = suite.load(arm, run.task, seed=seed, **task_options(run))
+  if isinstance(agent, learned.LearnedAgent) and agent.acting != run_settings.acting(run):
+    raise ValueError(
+      f"this agent acts as {agent.acting}, but the run asks for {run_settings.acting(run)}"
+    )
+  env = suite.load(arm, run.task, seed=seed, **run_settings.task_options(run))
   return evaluation.run_episode(env, agent, run.task, show_progress, unfinished)
 
 
@@ -312,36 +152,45 @@ def seed_entry(seed: int, episode: episodes.Episode, arm: robots.SoftArm) -> dic
 
 
 def evaluate(
-  agent: agents.Agent, arm: robots.SoftArm, run: RunSettings, seed: int, show_progress: bool = False
+  agent: agents.Agent,
+  arm: robots.SoftArm,
+  run: run_settings.RunSettings,
+  seed: int,
+  show_progress: bool = False,
 ) -> tuple[dict, tuple[int, ...]]:
   """``episode_on``, scored: the seed's record entry and the scored modules."""
   episode = episode_on(agent, arm, run, seed, show_progress)
   return seed_entry(seed, episode, arm), episode.scored_modules
 
 
-def seed_episode(run: RunSettings, seed: int, show_progress: bool = False) -> episodes.Episode:
+def seed_episode(
+  run: run_settings.RunSettings, seed: int, show_progress: bool = False
+) -> episodes.Episode:
   """Builds (trains) the agent of ``seed`` for the healthy robot, as a deployed controller would
   be, and runs it through one episode on the robot with ``run.faults``."""
   return _episode_and_arm(run, seed, show_progress)[0]
 
 
 def _episode_and_arm(
-  run: RunSettings, seed: int, show_progress: bool, unfinished: pathlib.Path | None = None
+  run: run_settings.RunSettings,
+  seed: int,
+  show_progress: bool,
+  unfinished: pathlib.Path | None = None,
 ) -> tuple[episodes.Episode, robots.SoftArm]:
   """``seed_episode``, and the (faulty) robot it ran on."""
   arm = robots.make(run.robot)
-  agent = agents.make(run.agent, arm, seed, run.profile, show_progress, acting(run))
+  agent = agents.make(run.agent, arm, seed, run.profile, show_progress, run_settings.acting(run))
   faulty = arm.with_faults(run.faults)
   return episode_on(agent, faulty, run, seed, show_progress, unfinished), faulty
 
 
-def score_seed(run: RunSettings, seed: int) -> dict:
+def score_seed(run: run_settings.RunSettings, seed: int) -> dict:
   """``seed_episode``'s record entry, without progress bars or kept episodes."""
   episode, arm = _episode_and_arm(run, seed, False)
   return seed_entry(seed, episode, arm)
 
 
-def resumed_seed(run: RunSettings, seed: int) -> tuple[dict, episodes.Episode] | None:
+def resumed_seed(run: run_settings.RunSettings, seed: int) -> tuple[dict, episodes.Episode] | None:
   """The episode of ``seed`` that an interrupted run of the same settings and code saved, with its
   record entry; None if there is none."""
   episode = episode_snapshots.load(run, seed)
@@ -351,7 +200,7 @@ def resumed_seed(run: RunSettings, seed: int) -> tuple[dict, episodes.Episode] |
 
 
 def fresh_seed(
-  run: RunSettings, seed: int, show_progress: bool = False
+  run: run_settings.RunSettings, seed: int, show_progress: bool = False
 ) -> tuple[dict, episodes.Episode]:
   """``seed_episode``'s record entry, checked to be finite (a record must hold it), and the
   episode; an episode of an agent that can resume one is kept while it runs
@@ -363,7 +212,9 @@ def fresh_seed(
   return entry, episode
 
 
-def _run_seed(seed: int, run: RunSettings, show_progress: bool) -> tuple[dict, episodes.Episode]:
+def _run_seed(
+  seed: int, run: run_settings.RunSettings, show_progress: bool
+) -> tuple[dict, episodes.Episode]:
   """The record entry and episode of ``seed``: ``resumed_seed``, else ``fresh_seed``, whose
   episode is saved at once for a later run to resume from."""
   outcome = resumed_seed(run, seed)
@@ -373,7 +224,7 @@ def _run_seed(seed: int, run: RunSettings, show_progress: bool) -> tuple[dict, e
   return outcome
 
 
-def weight_files(run: RunSettings) -> list[list[pathlib.Path]]:
+def weight_files(run: run_settings.RunSettings) -> list[list[pathlib.Path]]:
   """Per seed, the cache files a babbling learner of ``run`` is made of (checkpoint, forward
   models); none for the other agents."""
   learner = agents.learner(run.agent)
@@ -386,7 +237,7 @@ def weight_files(run: RunSettings) -> list[list[pathlib.Path]]:
   ]
 
 
-def take_from_zoo(run: RunSettings) -> tuple[list[str], bool]:
+def take_from_zoo(run: run_settings.RunSettings) -> tuple[list[str], bool]:
   """For an agent trained on babbling, the zoo files taken for the checkpoints of ``run``'s seeds
   that the data home lacks (``zoo.take``), and whether every one is now in the data home; for
   the other agents nothing, and False."""
@@ -402,7 +253,9 @@ def take_from_zoo(run: RunSettings) -> tuple[list[str], bool]:
   )
 
 
-def execute(run: RunSettings, show_progress: bool = True, workers: int | None = None) -> dict:
+def execute(
+  run: run_settings.RunSettings, show_progress: bool = True, workers: int | None = None
+) -> dict:
   """Runs every seed, in parallel processes on every core, and returns the result record.
 
   The babbling dataset is collected first (on every core), so that the seeds share it.
@@ -411,7 +264,10 @@ def execute(run: RunSettings, show_progress: bool = True, workers: int | None = 
 
 
 def execute_episodes(
-  run: RunSettings, show_progress: bool = True, workers: int | None = None, keep_seeds: bool = False
+  run: run_settings.RunSettings,
+  show_progress: bool = True,
+  workers: int | None = None,
+  keep_seeds: bool = False,
 ) -> tuple[dict, list[episodes.Episode]]:
   """``execute``, also returning every seed's episode (in seed order) for plots and videos;
   a learned agent's checkpoints that the data home lacks are taken from the zoo where it holds
@@ -455,7 +311,7 @@ def execute_episodes(
 
 
 def assemble_record(
-  run: RunSettings,
+  run: run_settings.RunSettings,
   origin: dict,
   outcomes: list[tuple[dict, episodes.Episode]],
   taken: list[str],

@@ -26,6 +26,7 @@ from softbench.records import provenance
 from softbench.robots import versions
 from softbench.runners import continual
 from softbench.runners import run as run_module
+from softbench.runners import run_settings
 from softbench.suite import references as suite_references
 
 
@@ -114,7 +115,7 @@ def rescored(record: dict, seed: int) -> dict:
       entry = continual.score_seed(seed, profile, False, pathlib.Path(kept), family)
   else:
     module = record["scored_modules"][0] if record["task"] == "reach" else None
-    settings = run_module.settings(
+    settings = run_settings.settings(
       record["task"],
       record["agent"],
       record["robot"],

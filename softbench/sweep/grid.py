@@ -1,7 +1,7 @@
 """A sweep's grid and the graph of work behind it, planned in the driver before Ray starts.
 
 Every setting of the grid (robot x task x agent x eval mode, one profile and seed count) is a
-``run.RunSettings``; one that already has a record of its profile, seeds and target
+``run_settings.RunSettings``; one that already has a record of its profile, seeds and target
 completion in the results folder is skipped (``existing_record``), as ``make leaderboard`` skips
 it. Each seed of the others is an ``Evaluation``, unless
 an interrupted run or sweep kept its episode (``episode_snapshots``). An evaluation of a learned
@@ -40,9 +40,10 @@ from softbench.records import fields as record_fields
 from softbench.robots import versions
 from softbench.runners import continual
 from softbench.runners import run as run_module
+from softbench.runners import run_settings
 
 KINDS = ("dataset", "forward", "agent", "network")  # What a build makes (network: Exp1S's).
-GridSetting = run_module.RunSettings | continual.Exp1sSettings  # A task's run, or an Exp1S run.
+GridSetting = run_settings.RunSettings | continual.Exp1sSettings  # A task's run, or an Exp1S run.
 
 
 @dataclasses.dataclass(frozen=True)
@@ -59,12 +60,12 @@ class Grid:
   eval_modes: tuple[str, ...] = ("physics",)
   families: tuple[str, ...] = ()
 
-  def settings(self) -> list[run_module.RunSettings]:
-    """Every task's setting once, checked (``run.settings``), robot by robot, then task, agent,
-    eval mode.
+  def settings(self) -> list[run_settings.RunSettings]:
+    """Every task's setting once, checked (``run_settings.settings``), robot by robot, then task,
+    agent, eval mode.
 
     Raises:
-      ValueError: an empty list, or a setting ``run.settings`` refuses (one line).
+      ValueError: an empty list, or a setting ``run_settings.settings`` refuses (one line).
     """
     if self.families and not (self.robots or self.tasks or self.agents):
       return []  # Exp1S alone.
@@ -77,7 +78,7 @@ class Grid:
       if not values:
         raise ValueError(f"a sweep needs at least one of its {name}")
     every = [
-      run_module.settings(task, agent, robot, self.seeds, self.profile, eval_mode)
+      run_settings.settings(task, agent, robot, self.seeds, self.profile, eval_mode)
       for robot, task, agent, eval_mode in itertools.product(
         self.robots, self.tasks, self.agents, self.eval_modes
       )

@@ -24,6 +24,7 @@ from softbench.episodes import snapshots as episode_snapshots
 from softbench.learning import inverse as inverse_training
 from softbench.runners import continual
 from softbench.runners import run as run_module
+from softbench.runners import run_settings
 from softbench.sweep import relay
 from softbench.sweep import shipping
 
@@ -92,7 +93,7 @@ def build(
 
 
 def evaluate(
-  run: run_module.RunSettings | continual.Exp1sSettings,
+  run: run_settings.RunSettings | continual.Exp1sSettings,
   seed: int,
   *needed: shipping.Files,
   states: relay.Relay | None = None,
