@@ -11,6 +11,7 @@ import pytest
 from softbench import cli
 from softbench import leaderboard
 from softbench import records
+from softbench.leaderboard import doc_pages
 from softbench.leaderboard import doc_tables
 from softbench.records import fields as record_fields
 
@@ -34,7 +35,7 @@ def board():
 
 @pytest.fixture(scope="module")
 def pages() -> dict[pathlib.Path, str]:
-  return {page: page.read_text(encoding="utf-8") for page in doc_tables.pages(RESULTS)}
+  return {page: page.read_text(encoding="utf-8") for page in doc_pages.pages(RESULTS)}
 
 
 def _block(name: str, body: str = "") -> str:
@@ -44,21 +45,21 @@ def _block(name: str, body: str = "") -> str:
 def test_the_pages_are_the_readme_and_the_docs(pages):
   assert ROOT / "README.md" in pages
   assert ROOT / "docs" / "paper-comparison.md" in pages
-  assert sum(len(doc_tables.blocks(text)) for text in pages.values()) >= len(doc_tables.TABLES)
+  assert sum(len(doc_pages.blocks(text)) for text in pages.values()) >= len(doc_tables.TABLES)
 
 
 def test_every_block_is_known_and_equals_what_the_records_give(pages, board):
   for page, text in pages.items():
-    assert doc_tables.stale_blocks(text, board, str(page)) == [], (
+    assert doc_pages.stale_blocks(text, board, str(page)) == [], (
       f"{page}: out of date; run softbench leaderboard --write"
     )
 
 
 def test_every_named_table_appears_in_the_docs(pages):
   shown = {
-    block.name.partition(doc_tables.PHYSICS_SEPARATOR)[0]
+    block.name.partition(doc_pages.PHYSICS_SEPARATOR)[0]
     for text in pages.values()
-    for block in doc_tables.blocks(text)
+    for block in doc_pages.blocks(text)
   }
   assert shown == set(doc_tables.TABLES)
 
@@ -66,7 +67,7 @@ def test_every_named_table_appears_in_the_docs(pages):
 def test_no_typed_table_of_scores_outside_the_blocks(pages):
   for page, text in pages.items():
     lines = text.split("\n")
-    inside = {line for block in doc_tables.blocks(text) for line in range(block.start, block.end)}
+    inside = {line for block in doc_pages.blocks(text) for line in range(block.start, block.end)}
     header = None
     for number, line in enumerate(lines):
       if not line.lstrip().startswith("|"):
@@ -81,11 +82,11 @@ def test_no_typed_table_of_scores_outside_the_blocks(pages):
 
 def test_an_unknown_table_fails(board):
   with pytest.raises(doc_tables.DocTableError, match=r"README.md:2: unknown table 'no-such'"):
-    doc_tables.blocks("text\n" + _block("no-such"), "README.md")
+    doc_pages.blocks("text\n" + _block("no-such"), "README.md")
   with pytest.raises(doc_tables.DocTableError, match="unknown table"):
-    doc_tables.render("no-such", board)
+    doc_pages.render("no-such", board)
   with pytest.raises(doc_tables.DocTableError, match="README.md:2: unknown physics version 'v9'"):
-    doc_tables.blocks("text\n" + _block("headline-spiral@v9"), "README.md")
+    doc_pages.blocks("text\n" + _block("headline-spiral@v9"), "README.md")
 
 
 def test_a_block_names_the_physics_of_its_records(board):
@@ -94,7 +95,7 @@ def test_a_block_names_the_physics_of_its_records(board):
   v0 = leaderboard.ranking.rank(
     [(path, record) for path, record in committed if record_fields.physics_of(record) == "v0"]
   )
-  assert doc_tables.render("headline-spiral@v0", board) == doc_tables.render("headline-spiral", v0)
+  assert doc_pages.render("headline-spiral@v0", board) == doc_pages.render("headline-spiral", v0)
 
 
 @pytest.mark.parametrize(
@@ -107,19 +108,19 @@ def test_a_block_names_the_physics_of_its_records(board):
 )
 def test_a_malformed_block_fails(text, message):
   with pytest.raises(doc_tables.DocTableError, match=message):
-    doc_tables.blocks(text)
+    doc_pages.blocks(text)
 
 
 def test_an_out_of_date_block_fails_and_rewriting_mends_it(pages, board):
   readme = pages[ROOT / "README.md"]
-  generated = doc_tables.render("headline-spiral@v0", board)
+  generated = doc_pages.render("headline-spiral@v0", board)
   edited = readme.replace(generated, generated.replace("6.69 ± 1.77", "6.59 ± 1.77"), 1)
   assert edited != readme
-  assert doc_tables.stale_blocks(edited, board) == ["headline-spiral@v0"]
-  assert doc_tables.rewrite(edited, board) == readme
+  assert doc_pages.stale_blocks(edited, board) == ["headline-spiral@v0"]
+  assert doc_pages.rewrite(edited, board) == readme
   emptied = readme.replace(generated, "", 1)
-  assert doc_tables.stale_blocks(emptied, board) == ["headline-spiral@v0"]
-  assert doc_tables.rewrite(emptied, board) == readme
+  assert doc_pages.stale_blocks(emptied, board) == ["headline-spiral@v0"]
+  assert doc_pages.rewrite(emptied, board) == readme
 
 
 @pytest.mark.parametrize(
@@ -134,7 +135,7 @@ def test_an_out_of_date_block_fails_and_rewriting_mends_it(pages, board):
   ],
 )
 def test_a_figure_is_up_to_date_within_one_unit_of_its_last_digit(shown, up_to_date):
-  assert doc_tables.same_figures(shown, "| smpl | 6.69 ± 1.77 |") is up_to_date
+  assert doc_pages.same_figures(shown, "| smpl | 6.69 ± 1.77 |") is up_to_date
 
 
 def _checkout_copy(root: pathlib.Path) -> pathlib.Path:
@@ -165,8 +166,8 @@ def test_a_record_made_again_on_another_machine_leaves_the_tables_up_to_date(tmp
   records.write(again, results / name.replace("2026-12-04T015317Z", "2026-12-31T235959Z"))
   board = leaderboard.build(results)
   assert board.of_physics("v0").groups, "the copy holds the v0 records"
-  for page in doc_tables.pages(results):
-    assert doc_tables.stale_blocks(page.read_text(encoding="utf-8"), board, str(page)) == [], page
+  for page in doc_pages.pages(results):
+    assert doc_pages.stale_blocks(page.read_text(encoding="utf-8"), board, str(page)) == [], page
 
 
 def test_the_tables_use_the_records_population_std(board):
@@ -175,7 +176,7 @@ def test_the_tables_use_the_records_population_std(board):
   smpl = (
     "| smpl | 11.50 ± 0.33 (4.97) | 2.74 ± 0.32 (2.77) | 2.84 ± 0.31 (2.38) | 2.51 ± 0.25 (3.02) |"
   )
-  assert smpl in doc_tables.render("overview-pneumatic-433-paper@v0", board)
+  assert smpl in doc_pages.render("overview-pneumatic-433-paper@v0", board)
 
 
 def test_leaderboard_write_rewrites_the_blocks_of_the_checkout(tmp_path, capsys):
@@ -195,7 +196,7 @@ def test_leaderboard_write_rewrites_the_blocks_of_the_checkout(tmp_path, capsys)
     ["leaderboard", "--results", str(results), "--write", "--out", str(tmp_path / "leaderboard")]
   )
   board = leaderboard.build(results)
-  expected = doc_tables.rewrite(stale, board)
+  expected = doc_pages.rewrite(stale, board)
   assert "20.00 ± 5.24 (1.49)" in expected and "typed" not in expected
   assert (tmp_path / "README.md").read_text() == expected
   assert (tmp_path / "docs" / "exp1s.md").read_text() == expected
@@ -212,8 +213,8 @@ def test_leaderboard_write_rewrites_the_blocks_of_the_checkout(tmp_path, capsys)
 
 def test_another_results_folder_has_no_doc_pages(tmp_path):
   (tmp_path / "README.md").write_text(_block("no-such"))
-  assert doc_tables.pages(tmp_path / "results") == []
-  assert doc_tables.pages(tmp_path / "leaderboard" / "results") == [tmp_path / "README.md"]
+  assert doc_pages.pages(tmp_path / "results") == []
+  assert doc_pages.pages(tmp_path / "leaderboard" / "results") == [tmp_path / "README.md"]
 
 
 README_MAX_LINES = 300  # A page a user reads in about five minutes (issue 26).

@@ -45,7 +45,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def handle(args: argparse.Namespace) -> None:
   from softbench import leaderboard
-  from softbench.leaderboard import doc_tables
+  from softbench.leaderboard import doc_pages
   from softbench.leaderboard import filters
   from softbench.leaderboard import grid
 
@@ -71,7 +71,7 @@ def handle(args: argparse.Namespace) -> None:
   if args.write:
     for path in [
       *leaderboard.write(board, results, pathlib.Path(args.out)),
-      *doc_tables.write(board, results),
+      *doc_pages.write(board, results),
     ]:
       print(f"wrote {path}")
 
