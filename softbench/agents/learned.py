@@ -81,6 +81,8 @@ class Acting:
   active_modules: tuple[int, ...] | None = None
 
   def __post_init__(self):
+    if self.active_modules is not None:  # Any sequence of module numbers, held as a tuple.
+      object.__setattr__(self, "active_modules", tuple(int(m) for m in self.active_modules))
     if self.error_source not in ERROR_SOURCES:
       raise ValueError(
         f"error_source must be one of {', '.join(ERROR_SOURCES)}, got {self.error_source!r}"
