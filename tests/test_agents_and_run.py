@@ -28,6 +28,7 @@ from softbench.records import fields
 from softbench.runners import evaluation
 from softbench.runners import parallel_seeds
 from softbench.runners import run
+from softbench.runners import run_settings
 
 # Every task of the suite on tendon-2, and one on the pneumatic arm.
 TASKS = tuple(pair for pair in suite.ALL_TASKS if pair[0] == "tendon-2") + (
@@ -206,6 +207,11 @@ def test_error_sources_differ_after_the_first_step(mode):
   open_loop = open_loop.actions
   np.testing.assert_array_equal(actions[0], open_loop[0])  # e_0 = 0 in every mode.
   assert np.array_equal(actions, open_loop) == (mode == "open-loop")
+  # A run scores an agent only as it asks it to act: one built to act otherwise is refused.
+  asked = run_settings.settings("circle", "smpl", "tendon-2", 1, "tiny", eval_mode="open-loop")
+  if mode != "open-loop":
+    with pytest.raises(ValueError, match=r"^this agent acts as .*, but the run asks for"):
+      run.episode_on(agent, agent.robot, asked, 0)
 
 
 def test_softbench_run_end_to_end(tmp_path, capsys):
