@@ -5,6 +5,7 @@ command line's help and listings run without it, and what seed workers import wi
 matplotlib."""
 
 import ast
+import functools
 import pathlib
 import subprocess
 import sys
@@ -25,7 +26,8 @@ def _unit(module: str) -> str | None:
   return parts[1] if exists else None
 
 
-def _imported(path: pathlib.Path, module: str, deferred: bool = True) -> set[str]:
+@functools.cache  # Every rule walks the same files: each is parsed once per process.
+def _imported(path: pathlib.Path, module: str, deferred: bool = True) -> frozenset[str]:
   """Every module named by an import statement of ``path`` (module ``module``), relative ones
   resolved; ``from a import b`` names both ``a`` and ``a.b``. Without ``deferred``, only the
   statements run on import (none inside a function)."""
@@ -41,7 +43,7 @@ def _imported(path: pathlib.Path, module: str, deferred: bool = True) -> set[str
         base = ".".join(anchor + ([node.module] if node.module else []))
       names.add(base)
       names.update(f"{base}.{alias.name}" for alias in node.names)
-  return names
+  return frozenset(names)
 
 
 def _nodes(tree: ast.AST, deferred: bool):
