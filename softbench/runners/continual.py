@@ -189,7 +189,7 @@ def _end_effector_scores(episode: episodes.Episode, length: float) -> dict:
 
 def finished_seeds_folder(profile: profiles.Profile, family: str = DEFAULT_FAMILY) -> pathlib.Path:
   """Where the scores of the seeds (and, under ``EPISODES_FOLDER``, of the episodes) that an
-  interrupted run finished are kept (``episode_snapshots``: keyed by the settings and the code)."""
+  interrupted run finished are kept (``episodes.snapshots``: keyed by the settings and the code)."""
   return episode_snapshots.keyed_folder(
     f"smpl-{PROTOCOL}", (dataclasses.asdict(profile), exp1s_training.protocol(family).robot_names)
   )

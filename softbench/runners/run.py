@@ -204,7 +204,7 @@ def fresh_seed(
 ) -> tuple[dict, episodes.Episode]:
   """``seed_episode``'s record entry, checked to be finite (a record must hold it), and the
   episode; an episode of an agent that can resume one is kept while it runs
-  (``episode_snapshots.partial_path``), and an interrupted one goes on."""
+  (``episodes.snapshots.partial_path``), and an interrupted one goes on."""
   unfinished = episode_snapshots.partial_path(run, seed)
   episode, arm = _episode_and_arm(run, seed, show_progress, unfinished)
   entry = seed_entry(seed, episode, arm)

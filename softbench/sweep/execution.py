@@ -7,7 +7,7 @@ builds are submitted at once; an evaluation only once its agent is built and the
 run leave a core free (``releasable``): Ray shares the cores fairly between kinds of task, so
 evaluations submitted early would delay the trainings that the sweep's end waits for. A task
 whose worker dies is run again (``cluster.MAX_RETRIES``). Each finished episode is kept at once
-(``episode_snapshots``), so an interrupted sweep resumes; once a setting's seeds are all in, its
+(``episodes.snapshots``), so an interrupted sweep resumes; once a setting's seeds are all in, its
 record (``run.assemble_record``, as ``softbench run`` makes it) is saved (``saving.save``) and
 its kept episodes go (an Exp1S run: ``continual.assemble_record``, its kept seeds' scores and its
 heat map of forgetting as ``softbench run --protocol exp1s`` leaves them). A task's error is not

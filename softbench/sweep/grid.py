@@ -4,7 +4,7 @@ Every setting of the grid (robot x task x agent x eval mode, one profile and see
 ``run_settings.RunSettings``; one that already has a record of its profile, seeds and target
 completion in the results folder is skipped (``existing_record``), as ``make leaderboard`` skips
 it. Each seed of the others is an ``Evaluation``, unless
-an interrupted run or sweep kept its episode (``episode_snapshots``). An evaluation of a learned
+an interrupted run or sweep kept its episode (``episodes.snapshots``). An evaluation of a learned
 agent needs the ``Build`` of that agent for its robot, seed and profile, shared by every task and
 eval mode; an agent trained on babbling needs the forward model of each view it reads (shared by
 the agents that read that view: the baselines share the whole arm's) and the robot's babbling

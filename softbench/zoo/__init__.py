@@ -20,8 +20,8 @@ the cache's usual loading.
 The zoo is ``$SOFTBENCH_ZOO`` if set (``none`` turns it off; anything else but a folder is
 refused), else the ``zoo/`` folder of the source checkout softbench runs from (``chosen_folder``:
 the one a ``softbench zoo`` command works on). Which records each file stands behind, and
-re-scoring them from the zoo alone, belong to the leaderboard (``leaderboard.zoo_catalogue``,
-``leaderboard.zoo_verification``); what ``softbench zoo list`` and ``zoo add`` print, to
+re-scoring them from the zoo alone, belong to the runners (``runners.zoo_catalogue``,
+``runners.zoo_verification``); what ``softbench zoo list`` and ``zoo add`` print, to
 ``zoo.listing``.
 """
 
