@@ -63,7 +63,6 @@ from softbench.robots import recorder
 from softbench.suite import trajectories
 
 DEFAULT_HELPER_TARGETS = "complete"
-DATA_SEED = inverse_training.DATA_SEED
 
 
 @dataclasses.dataclass(frozen=True)
@@ -369,7 +368,7 @@ def cache_files(
     robot,
     views,
     profile.samples,
-    DATA_SEED,
+    inverse_training.DATA_SEED,
     inverse_training.forward_config(seed, profile),
     checkpoints.TRAINING_VERSION,
   )
@@ -436,5 +435,5 @@ def babbling_candidates(
   """The poses of the babbling an agent of ``profile`` learned from (collected if the data home
   lacks it), which complete partial targets (``softbench.agents.completion``)."""
   return completion.Candidates.from_dataset(
-    data.collect(robot, samples=profile.samples, seed=DATA_SEED, progress=False)
+    data.collect(robot, samples=profile.samples, seed=inverse_training.DATA_SEED, progress=False)
   )

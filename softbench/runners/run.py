@@ -133,10 +133,9 @@ def episode_on(
 ) -> episodes.Episode:
   """One episode of ``run``'s task (environment seed ``seed``) by ``agent`` on ``arm``, which may
   be a faulty robot; kept while it runs at ``unfinished`` (``evaluation.run_episode``)."""
-  if isinstance(agent, learned.LearnedAgent) and agent.acting != run_settings.acting(run):
-    raise ValueError(
-      f"this agent acts as {agent.acting}, but the run asks for {run_settings.acting(run)}"
-    )
+  asked = run_settings.acting(run)
+  if isinstance(agent, learned.LearnedAgent) and agent.acting != asked:
+    raise ValueError(f"this agent acts as {agent.acting}, but the run asks for {asked}")
   env = suite.load(arm, run.task, seed=seed, **run_settings.task_options(run))
   return evaluation.run_episode(env, agent, run.task, show_progress, unfinished)
 

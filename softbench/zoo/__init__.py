@@ -260,7 +260,7 @@ def stored_config(path: pathlib.Path) -> dict:
   try:
     payload = torch.load(path, map_location="cpu", weights_only=True)
     return dict(payload["config"])
-  except Exception:  # Not a checkpoint (a training snapshot): no configuration to list.
+  except Exception:  # A file saved without a configuration (not smpl.checkpoint's): none to list.
     return {}
 
 
@@ -280,8 +280,7 @@ def add(
       (one line; nothing is changed).
   """
   home = storage.softbench_home()
-  before = read_manifest(zoo)
-  entries = dict(before)
+  entries = read_manifest(zoo)
   planned: dict[str, tuple[bytes, ZooFile]] = {}
   skipped = []
   for cache_file, kind in cache_files:
@@ -322,9 +321,6 @@ def add(
     )
   for path, (content, _) in planned.items():
     storage.write_atomically(zoo / path, content)
-  for stale in set(before) - set(updated):
-    (zoo / stale).unlink(missing_ok=True)
-    _remove_empty_parents(zoo / stale, zoo)
   write_manifest(zoo, updated)
   return [entry for _, entry in planned.values()], skipped
 
