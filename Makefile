@@ -9,7 +9,7 @@ STAMP := $(VENV)/.installed
 VENV_V0 := .venv-v0
 STAMP_V0 := $(VENV_V0)/.installed
 
-.PHONY: install install-v0 run run-v0 test smoke-v0 bench models leaderboard
+.PHONY: install install-v0 install-gpu run run-v0 test smoke-v0 bench models leaderboard
 
 # Python caches the bytecode of the modules it imports (a machine may switch that off with
 # PYTHONDONTWRITEBYTECODE): pip need not compile all 16,000 files it installs (about 50 s, one
@@ -33,6 +33,11 @@ $(STAMP_V0): pyproject.toml constraints-v0.txt
 install: $(STAMP)
 
 install-v0: $(STAMP_V0)
+
+# MuJoCo Warp (the gpu extra, 0.4 GB) for ArmBatch's warp backend; on the CPU it runs only the
+# parity tests (tests/test_batch.py), on a GPU the vector environments (docs/compute.md).
+install-gpu: $(STAMP)
+	$(VENV)/bin/pip install --quiet --no-compile -c constraints.txt -e '.[test,gpu]'
 
 run: $(STAMP)
 	$(VENV)/bin/softbench run --task spiral --agent smpl

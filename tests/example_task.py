@@ -26,9 +26,8 @@ class Hold(base.SoftArmTask):
   def scored_modules(self) -> tuple[int, ...]:
     return tuple(range(1, self.robot.num_modules + 1))
 
-  def initialize_episode(self, physics) -> None:
-    super().initialize_episode(physics)
-    self._start = physics.module_poses().copy()
+  def episode_started(self, poses: np.ndarray) -> None:
+    self._start = poses.copy()
 
   def targets_at(self, step: int) -> np.ndarray:
     return self._start.copy()

@@ -58,6 +58,30 @@ def layout(shapes: dict[str, tuple[int, ...]]) -> dict[str, slice]:
   return slices
 
 
+def observation_in(named: dict, form: str) -> np.ndarray | dict:
+  """The observation of named parts (``KEYS``) in ``form`` (``OBSERVATION_FORMS``), float64."""
+  if form == "dict":
+    return {key: np.array(named[key], dtype=np.float64) for key in KEYS}
+  return flatten(named)
+
+
+def errors(robot: robots.SoftArm, task, poses: np.ndarray, target: np.ndarray) -> dict[str, Any]:
+  """``step``'s info: the errors of ``poses`` (num_modules, 6) reached by a step of ``task``
+  (a ``SoftArmTask``) against the ``target`` it showed before it, per scored module."""
+  scored = tuple(task.scored_modules())
+  achieved = np.asarray(poses)[np.array(scored) - 1, : target.shape[-1]]
+  info = {
+    "scored_modules": scored,
+    "position_error_mm": metrics.position_error_mm(achieved, target),
+    "normalised_tip_error_percent": metrics.normalised_tip_error_percent(
+      achieved, target, robot.length
+    ),
+  }
+  if target.shape[-1] == 6:
+    info["orientation_error_deg"] = metrics.orientation_error_deg(achieved, target)
+  return info
+
+
 def _pose_box(spec, robot: robots.SoftArm) -> spaces.Box:
   """The Box of poses or targets (rows of position, then orientation vector if given): positions
   within ``REACH_FACTOR`` arm lengths of the base, as the suite accepts targets, and orientation
@@ -148,9 +172,7 @@ class SoftArmEnv(gymnasium.Env):
     return self._environment
 
   def _observation(self, named: dict) -> np.ndarray | dict:
-    if self._observation_form == "dict":
-      return {key: np.array(named[key], dtype=np.float64) for key in KEYS}
-    return flatten(named)
+    return observation_in(named, self._observation_form)
 
   def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
     """Starts an episode; ``seed`` gives the start and targets ``suite.load(seed=seed)`` gives."""
@@ -174,25 +196,10 @@ class SoftArmEnv(gymnasium.Env):
       raise RuntimeError("the episode has ended (or not started); call reset() first")
     time_step = self._environment.step(np.asarray(action, dtype=np.float64))
     self._ended = time_step.last()
-    info = self._errors(time_step.observation["poses"], self._target)
+    info = errors(self.robot, self._environment.task, time_step.observation["poses"], self._target)
     self._target = time_step.observation["target"]
     observation = self._observation(time_step.observation)
     return observation, float(time_step.reward), False, self._ended, info
-
-  def _errors(self, poses: np.ndarray, target: np.ndarray) -> dict[str, Any]:
-    """``step``'s info: the scored modules' errors of ``poses`` against ``target``."""
-    scored = tuple(self._environment.task.scored_modules())
-    achieved = np.asarray(poses)[np.array(scored) - 1, : target.shape[-1]]
-    info = {
-      "scored_modules": scored,
-      "position_error_mm": metrics.position_error_mm(achieved, target),
-      "normalised_tip_error_percent": metrics.normalised_tip_error_percent(
-        achieved, target, self.robot.length
-      ),
-    }
-    if target.shape[-1] == 6:
-      info["orientation_error_deg"] = metrics.orientation_error_deg(achieved, target)
-    return info
 
   def render(self) -> np.ndarray | None:
     """(height, width, 3) uint8: the arm and the current targets, with render_mode

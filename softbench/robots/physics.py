@@ -15,12 +15,13 @@ from softbench.robots import chain
 class SoftArmPhysics(mujoco.Physics):
   """Physics with per-module pose accessors and the robot's action map.
 
-  ``step(n)`` is exactly ``mj_step(model, data, n)`` (as ``PoseRecorder`` runs it, so replaying
-  a recorded action sequence reproduces its poses bit for bit), followed by ``mj_kinematics`` so
-  that the pose accessors read the state after the step.
+  ``step(n)`` is exactly ``mj_step(model, data, n)`` (as ``PoseRecorder`` and ``ArmBatch`` run
+  it, so replaying a recorded action sequence reproduces its poses bit for bit), followed by
+  ``mj_kinematics`` so that the pose accessors read the state after the step; in a suite
+  environment on physics v0, dm_control's legacy stepping instead (``versions``).
   """
 
-  legacy_step = False
+  legacy_step = False  # dm_control's Environment sets it: versions.PhysicsVersion.legacy_step.
 
   @classmethod
   def from_robot(cls, robot: base.SoftArm) -> "SoftArmPhysics":

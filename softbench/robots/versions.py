@@ -31,6 +31,12 @@ class PhysicsVersion:
     backbone: The tendon arms' backbone (``softbench.robots.tendon.BACKBONES``).
     description: One line for listings and the leaderboard.
     install: How to get the stack it runs on.
+    legacy_step: Whether an environment's control step runs dm_control's legacy stepping
+      (``mj_step2``, ``mj_step`` for the rest, ``mj_step1``; after a reset it continues from
+      dm_control's forward pass with actuation disabled) instead of ``mj_step``. The two agree
+      bit for bit on the tendon arms (Euler) and differ by up to 2e-5 m on the pneumatic arm
+      (implicitfast) after a control period. v0's records were made with it; from v1 every
+      stepping path (environments, babbling, references, ``ArmBatch``) runs ``mj_step``.
   """
 
   name: str
@@ -39,6 +45,7 @@ class PhysicsVersion:
   backbone: str
   description: str
   install: str
+  legacy_step: bool
 
 
 VERSIONS = {
@@ -51,6 +58,7 @@ VERSIONS = {
       "cable",
       "MuJoCo 3.17 + cable plugin",
       "make install-v0 (the old stack in .venv-v0: constraints-v0.txt)",
+      legacy_step=True,
     ),
     PhysicsVersion(
       "v1",
@@ -59,6 +67,7 @@ VERSIONS = {
       "rod",
       "MuJoCo 4 + plugin-free rod",
       "make install (the current stack in .venv: constraints.txt)",
+      legacy_step=False,
     ),
   )
 }

@@ -25,6 +25,7 @@ import numpy as np
 from softbench import robots
 from softbench.data import seeding
 from softbench.robots import physics as arm_physics
+from softbench.robots import versions
 from softbench.suite import base
 from softbench.suite import reach
 from softbench.suite import registry
@@ -117,6 +118,28 @@ def gives_whole_targets(robot: str | robots.SoftArm, task: str, **task_kwargs) -
   return partial is None or not partial(arm, task_kwargs)
 
 
+def build_task(
+  robot: str | robots.SoftArm, task: str, seed=None, **task_kwargs
+) -> tuple[robots.SoftArm, base.SoftArmTask]:
+  """The robot (faults included) and the task object of ``load``, without physics: what a batch
+  of arms (``softbench.envs.vector``) runs one task object per arm of. Arguments and errors as
+  ``load``'s."""
+  entry = describe(task)
+  arm = robots.make(robot) if isinstance(robot, str) else robot
+  if not isinstance(arm, robots.SoftArm):
+    raise ValueError(f"robot must be a name or a SoftArm, got {robot!r}")
+  options = set(inspect.signature(entry.build).parameters) - {"robot", "random"}
+  unknown = sorted(set(task_kwargs) - options)
+  if unknown:
+    raise ValueError(
+      f"task {task!r} has no option {unknown[0]!r}; its options: {', '.join(sorted(options))}"
+    )
+  if seed is not None and not isinstance(seed, np.random.RandomState):
+    seeding.check_seed(seed)
+  # Targets come from the robot as designed: an actuator fault changes the physics, not the task.
+  return arm, entry.build(arm.without_faults(), random=seed, **task_kwargs)
+
+
 def load(
   robot: str | robots.SoftArm,
   task: str,
@@ -141,24 +164,10 @@ def load(
     ValueError: unknown robot or task, an invalid task option, or a seed that is not an integer
       from 0 to ``seeding.MAX_SEED`` (one line).
   """
-  entry = describe(task)
-  arm = robots.make(robot) if isinstance(robot, str) else robot
-  if not isinstance(arm, robots.SoftArm):
-    raise ValueError(f"robot must be a name or a SoftArm, got {robot!r}")
-  options = set(inspect.signature(entry.build).parameters) - {"robot", "random"}
-  unknown = sorted(set(task_kwargs) - options)
-  if unknown:
-    raise ValueError(
-      f"task {task!r} has no option {unknown[0]!r}; its options: {', '.join(sorted(options))}"
-    )
-  if seed is not None and not isinstance(seed, np.random.RandomState):
-    seeding.check_seed(seed)
-  # Targets come from the robot as designed: an actuator fault changes the physics, not the task.
-  built = entry.build(arm.without_faults(), random=seed, **task_kwargs)
+  arm, built = build_task(robot, task, seed, **task_kwargs)
   physics = arm_physics.SoftArmPhysics.from_robot(arm)
-  return control.Environment(
-    physics, built, control_timestep=arm.control_timestep, **(environment_kwargs or {})
-  )
+  options = {"legacy_step": versions.current().legacy_step, **(environment_kwargs or {})}
+  return control.Environment(physics, built, control_timestep=arm.control_timestep, **options)
 
 
 __all__ = [
@@ -166,6 +175,7 @@ __all__ = [
   "BENCHMARKING",
   "TASKS",
   "TaskEntry",
+  "build_task",
   "describe",
   "gives_whole_targets",
   "length_options",

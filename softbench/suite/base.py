@@ -70,21 +70,42 @@ class SoftArmTask(suite_base.Task):
   def action_spec(self, physics: arm_physics.SoftArmPhysics) -> specs.BoundedArray:
     return specs.BoundedArray((physics.action_dim,), np.float64, -1.0, 1.0, name="action")
 
-  def initialize_episode(self, physics: arm_physics.SoftArmPhysics) -> None:
+  @property
+  def holds_initial_action(self) -> bool:
+    """Whether an episode starts by holding ``start_episode``'s action for one control period
+    from rest (False: it starts at rest)."""
+    return self._initial_actuation > 0
+
+  def start_episode(self) -> np.ndarray:
+    """Draws this episode's randomness and returns the action held from rest before it (its
+    first ``previous_action``); ``initialize_episode`` then holds it on the physics, a batch of
+    arms (``softbench.envs.vector``) on its own, and both call ``episode_started``. A task
+    overrides these two, not ``initialize_episode``, so that it also runs in a batch."""
     self._step = 0
     size = self._initial_actuation
-    action = self.random.uniform(-size, size, physics.action_dim)
-    if size > 0:
+    self._previous_action = self.random.uniform(-size, size, self.robot.action_dim)
+    return self._previous_action.copy()
+
+  def initialize_episode(self, physics: arm_physics.SoftArmPhysics) -> None:
+    action = self.start_episode()
+    if self.holds_initial_action:
       physics.set_action(action)
       physics.step(int(round(self.robot.control_timestep / physics.timestep())))
       physics.data.time = 0.0
-    self._previous_action = action
+    self.episode_started(physics.module_poses())
+
+  def episode_started(self, poses: np.ndarray) -> None:
+    """Called with the modules' poses (num_modules, 6) once the episode's start is reached."""
 
   def before_step(self, action: np.ndarray, physics: arm_physics.SoftArmPhysics) -> None:
     physics.set_action(action)
+    self.take_action(action)
+
+  def take_action(self, action: np.ndarray) -> None:
+    """Notes the action of the step about to run (the next ``previous_action``)."""
     self._previous_action = np.array(action, dtype=float)
 
-  def after_step(self, physics: arm_physics.SoftArmPhysics) -> None:
+  def after_step(self, physics: arm_physics.SoftArmPhysics | None = None) -> None:
     self._step += 1
 
   def observation_spec(self, physics: arm_physics.SoftArmPhysics) -> collections.OrderedDict:
@@ -101,15 +122,23 @@ class SoftArmTask(suite_base.Task):
     return 1.0 if self._step >= self.num_steps else None
 
   def get_observation(self, physics: arm_physics.SoftArmPhysics) -> collections.OrderedDict:
+    return self.observation_from(physics.module_poses())
+
+  def observation_from(self, poses: np.ndarray) -> collections.OrderedDict:
+    """The observation when the arm's modules are at ``poses`` (num_modules, 6)."""
     observation = collections.OrderedDict()
-    observation["poses"] = physics.module_poses()
+    observation["poses"] = np.array(poses, dtype=np.float64)
     observation["target"] = self.targets_at(self._step)
     observation["previous_action"] = self._previous_action.copy()
     return observation
 
   def get_reward(self, physics: arm_physics.SoftArmPhysics) -> float:
-    """Mean over scored modules of a tolerance reward on the distance to the step's target."""
-    achieved = physics.module_poses()[np.array(self.scored_modules()) - 1, :3]
+    return self.reward_from(physics.module_poses())
+
+  def reward_from(self, poses: np.ndarray) -> float:
+    """Mean over scored modules of a tolerance reward on the distance of ``poses``
+    (num_modules, 6), reached by the step just taken, to that step's target."""
+    achieved = np.asarray(poses)[np.array(self.scored_modules()) - 1, :3]
     distance = np.linalg.norm(achieved - self.targets_at(self._step - 1)[:, :3], axis=-1)
     length = self.robot.length
     return float(

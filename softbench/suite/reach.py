@@ -57,12 +57,12 @@ class Reach(base.SoftArmTask):
   def num_steps(self) -> int:
     return self._num_steps
 
-  def initialize_episode(self, physics) -> None:
+  def start_episode(self) -> np.ndarray:
     action = self.random.uniform(-1.0, 1.0, self.robot.action_dim)
     holds = int(np.ceil(TARGET_SETTLE_SECONDS / self.robot.control_timestep))
     poses = recorder.from_rest(self.robot, np.tile(action, (holds, 1)))
     self._target = poses[-1, self.module - 1, :3].copy()
-    super().initialize_episode(physics)
+    return super().start_episode()
 
   def targets_at(self, step: int) -> np.ndarray:
     return self._target[None].copy()
