@@ -27,10 +27,20 @@ TINY = profiles.get("tiny")
 FILE_OVERHEAD_BYTES = 64 * 2**10
 
 
+EPISODE_STEPS = 5  # Short episodes: two of them per arm in the tiny training below.
+
+
+def arms() -> int:
+  """The arms a training steps at once on the installed physics (1 on v0)."""
+  return sac.num_envs(sac.training_config(robots.make(ROBOT), 0, TINY))
+
+
 @pytest.fixture
 def home(tmp_path, monkeypatch, babbled_home):
   babbled_home(tmp_path / "home", ROBOT)
-  monkeypatch.setattr(sac, "CHUNK_STEPS", 50)  # Two chunks in the tiny profile's 100 steps.
+  monkeypatch.setattr(sac, "EPISODE_STEPS", EPISODE_STEPS)
+  monkeypatch.setattr(sac, "CHUNK_STEPS", EPISODE_STEPS)  # One episode per arm per chunk,
+  monkeypatch.setitem(sac.STEPS, "tiny", 2 * EPISODE_STEPS * arms())  # two chunks in all.
   monkeypatch.setattr(snapshots, "SAVE_INTERVAL_S", 0.0)  # Save after every chunk.
   return tmp_path / "home"
 
@@ -50,7 +60,7 @@ def test_an_interrupted_training_resumes_to_the_same_weights(
   arm = robots.make(ROBOT)
   whole = sac.train(arm, 0, TINY)
   assert whole["environment_steps"] == sac.STEPS["tiny"]
-  assert whole["episodes"] == sac.STEPS["tiny"] // sac.EPISODE_STEPS + 1  # The next one begun.
+  assert whole["episodes"] == 3 * arms()  # Two per arm, and the next one begun.
   babbled_home(tmp_path / "other", ROBOT)
   learn, calls = stable_baselines3.SAC.learn, []
 
@@ -64,7 +74,8 @@ def test_an_interrupted_training_resumes_to_the_same_weights(
     patched.setattr(stable_baselines3.SAC, "learn", interrupted_in_the_second_chunk)
     with pytest.raises(KeyboardInterrupt):
       sac.train(arm, 0, TINY)
-  assert calls == [0, 50]  # Saved after the first chunk, which learned from its last step.
+  # Saved after the first chunk, which learned from its last step.
+  assert calls == [0, EPISODE_STEPS * arms()]
   partial = sac.checkpoint_path(arm, 0, TINY).with_suffix(".partial.pt")
   assert partial.is_file() and not sac.checkpoint_path(arm, 0, TINY).exists()
   saved = torch.load(partial, weights_only=False)
@@ -122,3 +133,18 @@ def test_policy_input_scales_positions_only():
   np.testing.assert_array_equal(scaled[:12], [0, 0.5, 1, 3, 4, 5, 3, 3.5, 4, 9, 10, 11])
   np.testing.assert_array_equal(scaled[12:15], [0.5, 1.0, 1.5])
   np.testing.assert_array_equal(scaled[15:], named["previous_action"])
+
+
+@pytest.mark.skipif(arms() == 1, reason="vector training needs MuJoCo 4's batch (physics v1)")
+def test_the_arms_of_the_vector_stream_start_the_sequence_s_episodes_in_order(home):
+  arm = robots.make(ROBOT)
+  dataset = data.collect(
+    ROBOT, samples=TINY.samples, seed=inverse_training.DATA_SEED, progress=False
+  )
+  stream = streams.training_targets(dataset, 10)
+  batched = streams.TargetStreamVectorEnv(3, arm, stream, 10, seed=4, first_episode=1)
+  serial = streams.TargetStreamEnv(arm, stream, 10, seed=4, first_episode=1)
+  observations, _ = batched.reset()
+  for observation in observations:
+    np.testing.assert_array_equal(observation, serial.reset()[0])
+  assert batched.episodes_started == serial.episodes_started == 4

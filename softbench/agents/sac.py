@@ -30,17 +30,19 @@ from softbench import profiles
 from softbench import progress as progress_bars
 from softbench import storage
 from softbench.agents import base
+from softbench.agents import sb3_vector
 from softbench.envs import environment
 from softbench.envs import streams
 from softbench.learning import checkpoints
 from softbench.learning import inverse as inverse_training
 from softbench.robots import base as robot_base
+from softbench.robots import versions
 
 EPISODE_STEPS = 50  # Control steps (targets) per training episode.
 STEPS = {"paper": 300_000, "default": 30_000, "tiny": 100}  # Environment steps per profile.
 LEARNING_STARTS = {"paper": 5_000, "default": 2_000, "tiny": 50}  # Random steps before learning.
-CHUNK_STEPS = 1_000  # Steps per `learn` call; the state may be saved after each (a multiple of
-# EPISODE_STEPS, so that saves fall between episodes).
+CHUNK_STEPS = 1_000  # Steps per arm per `learn` call; the state may be saved after each (a
+# multiple of EPISODE_STEPS, so that saves fall between episodes).
 HYPERPARAMETERS = {
   "learning_rate": 3e-4,
   "batch_size": 256,
@@ -58,6 +60,12 @@ HYPERPARAMETERS = {
   "normalise_reward": True,
 }
 TRAINING_VERSION = 1  # Bump when training changes, so that cached models are not reused.
+# From physics v1 SAC trains on VECTOR_ENVS arms stepped at once (envs.streams'
+# TargetStreamVectorEnv through sb3_vector), one gradient step per environment step as before;
+# v0 keeps the one-arm training its records were made with (TRAINING_VERSION 1, same keys).
+VECTOR_ENVS = 8
+VECTOR_TRAINING_VERSION = 2
+VECTOR_HYPERPARAMETERS = {"num_envs": VECTOR_ENVS, "gradient_steps": VECTOR_ENVS}
 SPENT = ("environment_steps", "episodes", "wall_time_s")  # What a trained model records of its
 # training (training_summary).
 _FORMAT = "softbench-sac"
@@ -101,6 +109,8 @@ class SacConfig:
 
 
 def training_config(robot: robot_base.SoftArm, seed: int, profile: profiles.Profile) -> SacConfig:
+  one_arm = versions.current().name == versions.FIRST
+  hyperparameters = HYPERPARAMETERS if one_arm else {**HYPERPARAMETERS, **VECTOR_HYPERPARAMETERS}
   return SacConfig(
     robot.name,
     robot.physics_sha256(),
@@ -109,9 +119,15 @@ def training_config(robot: robot_base.SoftArm, seed: int, profile: profiles.Prof
     STEPS[profile.name],
     LEARNING_STARTS[profile.name],
     EPISODE_STEPS,
-    tuple(sorted(HYPERPARAMETERS.items())),
+    tuple(sorted(hyperparameters.items())),
     stable_baselines3.__version__.split(".")[0],
+    TRAINING_VERSION if one_arm else VECTOR_TRAINING_VERSION,
   )
+
+
+def num_envs(config: SacConfig) -> int:
+  """The arms ``config``'s training steps at once."""
+  return dict(config.hyperparameters).get("num_envs", 1)
 
 
 def checkpoint_path(
@@ -144,15 +160,20 @@ class _PolicyInput(vec_env.VecEnvWrapper):
 
 
 def _training_env(
-  robot: robot_base.SoftArm, seed: int, profile: profiles.Profile, first_episode: int
-) -> tuple[vec_env.VecEnv, streams.TargetStreamEnv]:
+  robot: robot_base.SoftArm, config: SacConfig, first_episode: int
+) -> tuple[vec_env.VecEnv, streams.TargetStreamEnv | streams.TargetStreamVectorEnv]:
   dataset = data.collect(
-    robot.name, samples=profile.samples, seed=inverse_training.DATA_SEED, progress=False
+    robot.name, samples=config.samples, seed=inverse_training.DATA_SEED, progress=False
   )
-  stream_env = streams.TargetStreamEnv(
-    robot, streams.training_targets(dataset, EPISODE_STEPS), EPISODE_STEPS, seed, first_episode
-  )
-  venv = vec_env.DummyVecEnv([lambda: stream_env])
+  targets = streams.training_targets(dataset, EPISODE_STEPS)
+  if num_envs(config) == 1:
+    stream_env = streams.TargetStreamEnv(robot, targets, EPISODE_STEPS, config.seed, first_episode)
+    venv = vec_env.DummyVecEnv([lambda: stream_env])
+  else:
+    stream_env = streams.TargetStreamVectorEnv(
+      num_envs(config), robot, targets, EPISODE_STEPS, config.seed, first_episode
+    )
+    venv = sb3_vector.GymnasiumVecEnv(stream_env)
   scaled = _PolicyInput(venv, stream_env.observation_shapes, robot.length)
   if HYPERPARAMETERS["normalise_reward"]:
     scaled = vec_env.VecNormalize(
@@ -161,10 +182,11 @@ def _training_env(
   return scaled, stream_env
 
 
-def _model_kwargs() -> dict:
-  values = dict(HYPERPARAMETERS)
+def _model_kwargs(config: SacConfig) -> dict:
+  values = dict(config.hyperparameters)
+  unused = ("net_arch", "normalise_reward", "num_envs")
   return {
-    **{key: value for key, value in values.items() if key not in ("net_arch", "normalise_reward")},
+    **{key: value for key, value in values.items() if key not in unused},
     "policy_kwargs": {"net_arch": list(values["net_arch"])},
   }
 
@@ -236,9 +258,9 @@ def _save_state(
     "replay_buffer": buffer_bytes.getvalue(),
     "random": _random_states(model),
     "reward_scale": _reward_scale(model.get_env()),
-    # Saves fall between episodes: the one under way has just begun, and a resumed
-    # training begins it again, at the observation the model holds.
-    "episode_under_way": stream_env.episodes_started - 1,
+    # Saves fall between episodes: the ones under way (one per arm) have just begun, and a
+    # resumed training begins them again, at the observation the model holds.
+    "episode_under_way": stream_env.episodes_started - num_envs(config),
     "last_observation": last_observation,
     "wall_time_s": elapsed,
   }
@@ -280,9 +302,7 @@ def _trained(
   )
   device = training.default_device()
   with training.limited_cpu_threads(training.CPU_THREADS, device):
-    venv, stream_env = _training_env(
-      robot, seed, profile, state["episode_under_way"] if state else 0
-    )
+    venv, stream_env = _training_env(robot, config, state["episode_under_way"] if state else 0)
     if state is None:
       model = stable_baselines3.SAC(
         "MlpPolicy",
@@ -291,7 +311,7 @@ def _trained(
         device=device,
         buffer_size=config.steps,
         learning_starts=config.learning_starts,
-        **_model_kwargs(),
+        **_model_kwargs(config),
       )
       elapsed = 0.0
     else:
@@ -315,7 +335,7 @@ def _trained(
       f"sac {robot.name} seed {seed}", config.steps, model.num_timesteps, show_progress
     ) as bar:
       while model.num_timesteps < config.steps:
-        chunk = min(CHUNK_STEPS, config.steps - model.num_timesteps)
+        chunk = min(CHUNK_STEPS * num_envs(config), config.steps - model.num_timesteps)
         model.learn(chunk, reset_num_timesteps=False)
         bar.update(model.num_timesteps)
         if (

@@ -9,13 +9,17 @@ by the seed, so a training that resumes at episode i sees what it would have see
 """
 
 import gymnasium
+from gymnasium.vector import AutoresetMode
 import numpy as np
 
 from softbench import robots
+from softbench import suite
 from softbench.data import dataset as babbling_dataset
 from softbench.data import seeding
 from softbench.data import splits
 from softbench.envs import environment
+from softbench.envs import vector
+from softbench.suite import base as task_base
 
 
 def training_targets(data: babbling_dataset.Dataset, episode_steps: int) -> list[np.ndarray]:
@@ -30,6 +34,31 @@ def training_targets(data: babbling_dataset.Dataset, episode_steps: int) -> list
       "more samples or shorten the episodes"
     )
   return usable
+
+
+class EpisodeSequence:
+  """The seed's sequence of episodes on ``stream``: episode i's targets and start seed.
+
+  Raises:
+    ValueError: a bad seed, or a piece of the stream shorter than ``episode_steps`` (one line).
+  """
+
+  def __init__(self, stream: list[np.ndarray], episode_steps: int, seed: int):
+    seeding.check_seed(seed)
+    if not all(len(piece) >= episode_steps for piece in stream) or not stream:
+      raise ValueError(f"every piece of the stream needs at least {episode_steps} targets")
+    self._stream = stream
+    self._weights = np.array([len(piece) - episode_steps + 1 for piece in stream], float)
+    self._weights /= self._weights.sum()
+    self._episode_steps = episode_steps
+    self._seed = seed
+
+  def window(self, episode: int) -> tuple[np.ndarray, int]:
+    """The targets (episode_steps, num_modules, 6) of ``episode`` and its start's seed."""
+    draw = seeding.rng(self._seed, seeding.TARGET_STREAM_EPISODES, episode)
+    piece = self._stream[draw.choice(len(self._stream), p=self._weights)]
+    start = int(draw.integers(0, len(piece) - self._episode_steps + 1))
+    return piece[start : start + self._episode_steps], int(draw.integers(0, seeding.MAX_SEED))
 
 
 class TargetStreamEnv(gymnasium.Env):
@@ -57,15 +86,9 @@ class TargetStreamEnv(gymnasium.Env):
     seed: int,
     first_episode: int = 0,
   ):
-    seeding.check_seed(seed)
-    if not all(len(piece) >= episode_steps for piece in stream) or not stream:
-      raise ValueError(f"every piece of the stream needs at least {episode_steps} targets")
+    self._sequence = EpisodeSequence(stream, episode_steps, seed)
     self.robot = robot
-    self._stream = stream
-    self._weights = np.array([len(piece) - episode_steps + 1 for piece in stream], float)
-    self._weights /= self._weights.sum()
     self.episode_steps = episode_steps
-    self._seed = seed
     self.episodes_started = first_episode
     self._env = environment.SoftArmEnv(robot, "custom", trajectory=stream[0][:episode_steps])
     self.observation_space = self._env.observation_space
@@ -74,10 +97,7 @@ class TargetStreamEnv(gymnasium.Env):
 
   def window(self, episode: int) -> tuple[np.ndarray, int]:
     """The targets (episode_steps, num_modules, 6) of ``episode`` and its start's seed."""
-    draw = seeding.rng(self._seed, seeding.TARGET_STREAM_EPISODES, episode)
-    piece = self._stream[draw.choice(len(self._stream), p=self._weights)]
-    start = int(draw.integers(0, len(piece) - self.episode_steps + 1))
-    return piece[start : start + self.episode_steps], int(draw.integers(0, seeding.MAX_SEED))
+    return self._sequence.window(episode)
 
   def reset(self, *, seed=None, options=None):
     del seed, options  # The episodes are the seed's sequence (class docstring).
@@ -88,3 +108,46 @@ class TargetStreamEnv(gymnasium.Env):
 
   def step(self, action):
     return self._env.step(action)
+
+
+class TargetStreamVectorEnv(vector.SoftArmVectorEnv):
+  """``TargetStreamEnv`` on ``num_envs`` arms at once (``vector.SoftArmVectorEnv``, autoreset
+  ``SAME_STEP``, as Stable-Baselines3 expects): every episode an arm starts is the next of the
+  seed's sequence, the arms taking them in index order, so that a training that resumes at
+  episode i sees what it would have seen. ``reset``'s seeds are not used.
+
+  Args:
+    num_envs: how many arms.
+    robot, stream, episode_steps, seed, first_episode: as ``TargetStreamEnv`` takes them.
+    **options: ``SoftArmVectorEnv``'s (``backend``, ``threads``).
+  """
+
+  def __init__(
+    self,
+    num_envs: int,
+    robot: robots.SoftArm,
+    stream: list[np.ndarray],
+    episode_steps: int,
+    seed: int,
+    first_episode: int = 0,
+    **options,
+  ):
+    self._sequence = EpisodeSequence(stream, episode_steps, seed)
+    self.episode_steps = episode_steps
+    self.episodes_started = first_episode
+    super().__init__(
+      num_envs,
+      robot,
+      "custom",
+      autoreset_mode=AutoresetMode.SAME_STEP,
+      trajectory=stream[0][:episode_steps],
+      **options,
+    )
+
+  def episode_task(self, arm: int, seed: int | None) -> task_base.SoftArmTask:
+    del seed  # The episodes are the seed's sequence (class docstring).
+    targets, start_seed = self._sequence.window(self.episodes_started)
+    self.episodes_started += 1
+    task = suite.build_task(self.robot, "custom", trajectory=targets)[1]
+    task.reseed(start_seed)
+    return task

@@ -3,7 +3,9 @@
 - ``cpu`` (``CpuArmBatch``): MuJoCo's own ``mujoco.batch.Batch`` (MuJoCo 4, physics v1), every
   arm a state row stepped on a persistent thread pool. Bit for bit the serial path
   (``SoftArmPhysics.set_action`` then ``step``: ``mj_step`` on one ``MjData`` per arm) at any
-  thread count.
+  thread count. On MuJoCo 3 (the old stack, physics v0), which has no ``mujoco.batch``,
+  ``RolloutArmBatch`` does the same with ``mujoco.rollout`` (the arms have no constraints, so
+  chaining rollouts through full physics states is bit for bit ``mj_step`` too).
 - ``warp`` (``batch_warp.WarpArmBatch``): MuJoCo Warp, on a CUDA GPU where one is present (on the
   CPU, slowly, for tests); float32 arithmetic, within ``batch_warp.PARITY_TOLERANCE_M`` of the
   serial path over a control period. Needs the ``gpu`` extra (``make install-gpu``).
@@ -15,9 +17,11 @@ call leaves out keeps its state, so a vector environment resets some arms while 
 
 import abc
 from collections.abc import Sequence
+import importlib.util
 import os
 
 import mujoco
+from mujoco import rollout
 import numpy as np
 
 from softbench.robots import base
@@ -118,6 +122,13 @@ class ArmBatch(abc.ABC):
     self.close()
 
 
+def _thread_count(threads: int | None, num_arms: int) -> int:
+  threads = (os.cpu_count() or 1) if threads is None else threads
+  if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
+    raise ValueError(f"threads must be a positive integer, got {threads!r}")
+  return min(threads, num_arms)
+
+
 class CpuArmBatch(ArmBatch):
   """The ``cpu`` backend: ``mujoco.batch.Batch`` on ``threads`` threads (all cores if None)."""
 
@@ -133,11 +144,8 @@ class CpuArmBatch(ArmBatch):
 
     model = model if model is not None else robot.compile()
     super().__init__(robot, num_arms, model)
-    threads = (os.cpu_count() or 1) if threads is None else threads
-    if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
-      raise ValueError(f"threads must be a positive integer, got {threads!r}")
     self.model = model
-    self._batch = batch.Batch(model, self.num_arms, nthread=min(threads, self.num_arms))
+    self._batch = batch.Batch(model, self.num_arms, nthread=_thread_count(threads, self.num_arms))
     self._ctrl = self._batch.bind("ctrl")
     self._time = self._batch.bind("time")
     self._site_xpos = self._batch.bind("site_xpos")
@@ -199,6 +207,93 @@ class CpuArmBatch(ArmBatch):
     self._batch = None
 
 
+class RolloutArmBatch(ArmBatch):
+  """The ``cpu`` backend on MuJoCo 3: full physics states advanced by ``mujoco.rollout`` on a
+  persistent thread pool of ``threads`` threads (all cores if None)."""
+
+  def __init__(
+    self,
+    robot: base.SoftArm,
+    num_arms: int,
+    threads: int | None = None,
+    model: mujoco.MjModel | None = None,
+  ):
+    model = model if model is not None else robot.compile()
+    super().__init__(robot, num_arms, model)
+    self.model = model
+    threads = _thread_count(threads, self.num_arms)
+    self._runner = rollout.Rollout(nthread=threads)
+    self._datas = [mujoco.MjData(model) for _ in range(threads)]
+    self._scratch = mujoco.MjData(model)
+    self._rest = np.empty(self.state_size)
+    mujoco.mj_getState(model, self._scratch, self._rest, STATE_SPEC)
+    self._states = np.tile(self._rest, (self.num_arms, 1))
+
+  @property
+  def state_size(self) -> int:
+    return mujoco.mj_stateSize(self.model, STATE_SPEC)
+
+  def reset(self, arms: Arms = None) -> None:
+    self._states[self.arm_indices(arms)] = self._rest
+
+  def hold(self, actions: np.ndarray, arms: Arms = None) -> None:
+    indices = self.arm_indices(arms)
+    controls = self.controls(actions, len(indices))
+    trajectory = np.empty((len(indices), self.steps_per_period, self.state_size))
+    self._runner.rollout(
+      [self.model] * len(indices),
+      self._datas,
+      self._states[indices],
+      controls[:, None],
+      nstep=self.steps_per_period,
+      state=trajectory,
+    )
+    self._states[indices] = trajectory[:, -1]
+    # MuJoCo resets a diverging simulation to the rest state and counts a warning.
+    bad_acceleration = mujoco.mjtWarning.mjWARN_BADQACC
+    diverged = any(data.warning[bad_acceleration].number for data in self._datas)
+    if diverged or not np.all(np.isfinite(trajectory[:, -1])):
+      raise FloatingPointError(f"{self.robot.name}: simulation unstable")
+
+  def poses(self, arms: Arms = None) -> np.ndarray:
+    indices = self.arm_indices(arms)
+    poses = np.empty((len(indices), len(self._sites), POSE_SIZE))
+    for pose, state in zip(poses, self._states[indices]):
+      mujoco.mj_setState(self.model, self._scratch, state, STATE_SPEC)
+      mujoco.mj_kinematics(self.model, self._scratch)
+      pose[:, :3] = self._scratch.site_xpos[self._sites]
+      pose[:, 3:] = self._scratch.site_xmat[self._sites].reshape(-1, 3, 3)[:, :, 2]
+    return poses
+
+  def set_time(self, time: float, arms: Arms = None) -> None:
+    self._states[self.arm_indices(arms), 0] = time  # Time leads a full physics state.
+
+  def states(self, arms: Arms = None) -> np.ndarray:
+    """(len(arms), state_size): full physics states (``mjSTATE_FULLPHYSICS``)."""
+    return self._states[self.arm_indices(arms)].copy()
+
+  def set_states(self, states: np.ndarray, arms: Arms = None) -> None:
+    """Puts ``arms`` in full physics states (len(arms), state_size), as ``states`` gives them."""
+    indices = self.arm_indices(arms)
+    self._states[indices] = np.asarray(states, np.float64).reshape(len(indices), self.state_size)
+
+  def close(self) -> None:
+    self._runner.close()
+
+
+def cpu(
+  robot: base.SoftArm,
+  num_arms: int,
+  threads: int | None = None,
+  model: mujoco.MjModel | None = None,
+) -> CpuArmBatch | RolloutArmBatch:
+  """The ``cpu`` backend of the installed MuJoCo (module docstring); ``model``: the robot's
+  compiled model (default ``robot.compile()``), e.g. a copy of an environment's."""
+  if importlib.util.find_spec("mujoco.batch") is None:
+    return RolloutArmBatch(robot, num_arms, threads=threads, model=model)
+  return CpuArmBatch(robot, num_arms, threads=threads, model=model)
+
+
 def make(
   robot: base.SoftArm, num_arms: int, backend: str = "auto", threads: int | None = None
 ) -> ArmBatch:
@@ -214,7 +309,7 @@ def make(
 
     backend = "warp" if batch_warp.cuda_available() else "cpu"
   if backend == "cpu":
-    return CpuArmBatch(robot, num_arms, threads=threads)
+    return cpu(robot, num_arms, threads=threads)
   from softbench.robots import batch_warp
 
   return batch_warp.WarpArmBatch(robot, num_arms)

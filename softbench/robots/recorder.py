@@ -1,24 +1,24 @@
 """Drives a robot with action sequences and records every module's pose after each control step.
 
 One recorder serves motor babbling, reference trajectories and replay checks. Episodes run side
-by side on MuJoCo's ``rollout`` thread pool, one control period per call, so that every episode
-advances in step with the others and a long recording can be saved and resumed between periods.
-The arms have no constraints (``nefc`` is 0), so chaining ``rollout`` calls through the full
-physics state reproduces uninterrupted stepping bit for bit (``mj_step`` with the same controls).
+by side as one ``ArmBatch`` (``softbench.robots.batch``, its ``cpu`` backend: MuJoCo's thread
+pool), one control period per call, so that every episode advances in step with the others and a
+long recording can be saved and resumed between periods from full physics states, bit for bit
+(``mj_step`` with the same controls).
 """
 
 import functools
 from typing import Callable
 
 import mujoco
-from mujoco import rollout
 import numpy as np
 
 from softbench.robots import base
+from softbench.robots import batch
 from softbench.robots import chain
 
-POSE_SIZE = 6  # Tip position (m) and unit orientation vector of one module.
-STATE_SPEC = mujoco.mjtState.mjSTATE_FULLPHYSICS
+POSE_SIZE = batch.POSE_SIZE
+STATE_SPEC = batch.STATE_SPEC
 # Recordings from rest that ``from_rest`` keeps per process: a 1,000-step reference of a
 # 5-module arm holds 240 kB of poses, a reach target's 4 to 16 poses 1 to 2.3 kB.
 FROM_REST_CACHE_SIZE = 64
@@ -36,9 +36,6 @@ class PoseRecorder:
     self.workers = workers
     self.model = model if model is not None else robot.compile()
     self.steps_per_action = int(round(robot.control_timestep / self.model.opt.timestep))
-    # The map as stored in the MJCF, exactly as SoftArmPhysics.set_action reads it.
-    self._action_map = self.model.numeric(base.ACTION_MAP_NAME).data.reshape(-1, 4).copy()
-    self._data = [mujoco.MjData(self.model) for _ in range(workers)]
     self._scratch = mujoco.MjData(self.model)
     self._sites = [
       self.model.site(chain.tip_site_name(k)).id for k in range(1, robot.num_modules + 1)
@@ -66,12 +63,6 @@ class PoseRecorder:
       poses[index, :, :3] = self._scratch.site_xpos[self._sites]
       poses[index, :, 3:] = self._scratch.site_xmat[self._sites].reshape(-1, 3, 3)[:, :, 2]
     return poses.reshape(states.shape[:-1] + poses.shape[1:])
-
-  def _check_stable(self, states: np.ndarray, step: int) -> None:
-    # MuJoCo resets a diverging simulation to the rest state and counts a warning.
-    diverged = any(data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number for data in self._data)
-    if diverged or not np.all(np.isfinite(states)):
-      raise FloatingPointError(f"{self.robot.name}: simulation unstable at control step {step}")
 
   def record(
     self,
@@ -102,30 +93,20 @@ class PoseRecorder:
     if not np.all(np.isfinite(actions)) or np.any(np.abs(actions) > 1.0):
       raise ValueError("actions must be finite and lie in [-1, 1]")
     episodes, steps = actions.shape[:2]
-    if initial_states is None:
-      states = np.tile(self.rest_state(), (episodes, 1))
-    else:
-      states = np.array(initial_states, dtype=float).reshape(episodes, self.state_size)
-    controls = base.action_to_ctrl(self._action_map, actions)
     poses = np.empty((episodes, steps + 1, len(self._sites), POSE_SIZE))
-    poses[:, 0] = self.poses(states)
-    buffer = np.empty((episodes, self.steps_per_action, self.state_size))
-    with rollout.Rollout(nthread=self.workers) as runner:
+    with batch.cpu(self.robot, episodes, threads=self.workers, model=self.model) as arms:
+      if initial_states is not None:
+        arms.set_states(np.asarray(initial_states, dtype=float).reshape(episodes, -1))
+      poses[:, 0] = arms.poses()
       for step in range(steps):
-        runner.rollout(
-          [self.model] * episodes,
-          self._data,
-          states,
-          controls[:, step, None],
-          nstep=self.steps_per_action,
-          state=buffer,
-        )
-        states = buffer[:, -1].copy()
-        self._check_stable(states, step)
-        poses[:, step + 1] = self.poses(states)
+        try:
+          arms.hold(actions[:, step])
+        except FloatingPointError as error:
+          raise FloatingPointError(f"{error} at control step {step}") from None
+        poses[:, step + 1] = arms.poses()
         if on_step is not None:
           on_step(episodes)
-    return poses, states
+      return poses, arms.states()
 
 
 def from_rest(robot: base.SoftArm, actions: np.ndarray) -> np.ndarray:
