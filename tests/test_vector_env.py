@@ -21,8 +21,8 @@ pytestmark = pytest.mark.skipif(
 )
 
 ARMS = 3
-EPISODE_STEPS = 2  # Short episodes, so that every arm's episode ends and autoresets.
-STEPS = 5  # Steps of each comparison: two episodes and an autoreset.
+EPISODE_STEPS = 1  # One-step episodes, so that every arm's episode ends and autoresets.
+STEPS = 3  # Steps of each comparison: an episode, an autoreset (NEXT_STEP) and another.
 FAMILY_ROBOTS = sorted({family.example for family in robots.FAMILIES})
 MODES = tuple(AutoresetMode)
 PAIRS = tuple(
