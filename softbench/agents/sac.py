@@ -170,8 +170,10 @@ def _training_env(
     stream_env = streams.TargetStreamEnv(robot, targets, EPISODE_STEPS, config.seed, first_episode)
     venv = vec_env.DummyVecEnv([lambda: stream_env])
   else:
+    # The CPU backend on every machine: its physics is the serial path's bit for bit, so that a
+    # seed trains to the same weights with or without a GPU (MuJoCo Warp computes in float32).
     stream_env = streams.TargetStreamVectorEnv(
-      num_envs(config), robot, targets, EPISODE_STEPS, config.seed, first_episode
+      num_envs(config), robot, targets, EPISODE_STEPS, config.seed, first_episode, backend="cpu"
     )
     venv = sb3_vector.GymnasiumVecEnv(stream_env)
   scaled = _PolicyInput(venv, stream_env.observation_shapes, robot.length)
