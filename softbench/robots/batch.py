@@ -44,9 +44,13 @@ class ArmBatch(abc.ABC):
     steps_per_period: MuJoCo steps in one control period.
   """
 
-  def __init__(self, robot: base.SoftArm, num_arms: int, model: mujoco.MjModel):
+  def __init__(self, robot: base.SoftArm, num_arms: int, model: mujoco.MjModel | None = None):
+    """``model``: the robot's compiled model (default ``robot.compile()``), e.g. a copy of an
+    environment's."""
     if isinstance(num_arms, bool) or not isinstance(num_arms, int | np.integer) or num_arms < 1:
       raise ValueError(f"the number of arms must be a positive integer, got {num_arms!r}")
+    model = model if model is not None else robot.compile()
+    self.model = model
     self.robot = robot
     self.num_arms = int(num_arms)
     self.steps_per_period = int(round(robot.control_timestep / model.opt.timestep))
@@ -55,6 +59,11 @@ class ArmBatch(abc.ABC):
     self._sites = np.array(
       [model.site(chain.tip_site_name(k)).id for k in range(1, robot.num_modules + 1)]
     )
+
+  @property
+  def state_size(self) -> int:
+    """Entries of a full physics state (``STATE_SPEC``)."""
+    return mujoco.mj_stateSize(self.model, STATE_SPEC)
 
   def arm_indices(self, arms: Arms) -> np.ndarray:
     """``arms`` as an int array of distinct indices (every arm for None).
@@ -139,18 +148,16 @@ class CpuArmBatch(ArmBatch):
     threads: int | None = None,
     model: mujoco.MjModel | None = None,
   ):
-    """``model``: the robot's compiled model (default ``robot.compile()``)."""
     from mujoco import batch  # MuJoCo 4 (physics v1); the old stack has no batch module.
 
-    model = model if model is not None else robot.compile()
     super().__init__(robot, num_arms, model)
-    self.model = model
-    self._batch = batch.Batch(model, self.num_arms, nthread=_thread_count(threads, self.num_arms))
+    threads = _thread_count(threads, self.num_arms)
+    self._batch = batch.Batch(self.model, self.num_arms, nthread=threads)
     self._ctrl = self._batch.bind("ctrl")
     self._time = self._batch.bind("time")
     self._site_xpos = self._batch.bind("site_xpos")
     self._site_xmat = self._batch.bind("site_xmat")
-    self._scratch = mujoco.MjData(model)
+    self._scratch = mujoco.MjData(self.model)
     self._bad_acceleration = int(mujoco.mjtWarning.mjWARN_BADQACC)
     self.reset()
 
@@ -180,10 +187,6 @@ class CpuArmBatch(ArmBatch):
 
   def set_time(self, time: float, arms: Arms = None) -> None:
     self._time[self.arm_indices(arms)] = time
-
-  @property
-  def state_size(self) -> int:
-    return mujoco.mj_stateSize(self.model, STATE_SPEC)
 
   def states(self, arms: Arms = None) -> np.ndarray:
     """(len(arms), state_size): full physics states (``mjSTATE_FULLPHYSICS``)."""
@@ -218,20 +221,14 @@ class RolloutArmBatch(ArmBatch):
     threads: int | None = None,
     model: mujoco.MjModel | None = None,
   ):
-    model = model if model is not None else robot.compile()
     super().__init__(robot, num_arms, model)
-    self.model = model
     threads = _thread_count(threads, self.num_arms)
     self._runner = rollout.Rollout(nthread=threads)
-    self._datas = [mujoco.MjData(model) for _ in range(threads)]
-    self._scratch = mujoco.MjData(model)
+    self._datas = [mujoco.MjData(self.model) for _ in range(threads)]
+    self._scratch = mujoco.MjData(self.model)
     self._rest = np.empty(self.state_size)
-    mujoco.mj_getState(model, self._scratch, self._rest, STATE_SPEC)
+    mujoco.mj_getState(self.model, self._scratch, self._rest, STATE_SPEC)
     self._states = np.tile(self._rest, (self.num_arms, 1))
-
-  @property
-  def state_size(self) -> int:
-    return mujoco.mj_stateSize(self.model, STATE_SPEC)
 
   def reset(self, arms: Arms = None) -> None:
     self._states[self.arm_indices(arms)] = self._rest

@@ -46,8 +46,8 @@ class WarpArmBatch(batch.ArmBatch):
     import mujoco_warp
     import warp
 
-    model = robot.compile()
-    super().__init__(robot, num_arms, model)
+    super().__init__(robot, num_arms)
+    model = self.model
     if model.nv > DENSE_LIMIT:
       model.opt.jacobian = mujoco.mjtJacobian.mjJAC_SPARSE
     self._warp, self._mjw = warp, mujoco_warp
