@@ -14,6 +14,7 @@ from softbench import robots
 from softbench import suite
 import softbench.envs
 from softbench.envs import vector
+from softbench.robots import faults
 from softbench.robots import versions
 
 pytestmark = pytest.mark.skipif(
@@ -117,3 +118,15 @@ def test_bad_steps_and_resets_get_clear_errors():
     env.reset(options={"reset_mask": [True, False]})
   with pytest.raises(ValueError, match="seeds"):
     env.reset(seed=[1, 2, 3])
+
+
+def test_a_faulty_arm_through_the_generic_id_steps_as_its_serial_counterpart():
+  """``softbench/SoftArm-vN`` with a robot spec: the fault is in every arm's physics, not in the
+  targets (as ``suite.load`` has it)."""
+  arm = robots.make("tendon-1").with_faults([faults.Fault(module=1, actuator=0, gain=0.0)])
+  options = {"robot": arm, "task": "circle", "length": EPISODE_STEPS}
+  batched = gymnasium.make_vec(softbench.envs.ANY_ROBOT_ID, 2, backend="cpu", **options)
+  serial = gymnasium.make_vec(softbench.envs.ANY_ROBOT_ID, 2, vectorization_mode="sync", **options)
+  assert env_checker.data_equivalence(batched.reset(seed=1), serial.reset(seed=1), exact=True)
+  action = np.full(batched.action_space.shape, 0.8, np.float32)
+  assert env_checker.data_equivalence(batched.step(action), serial.step(action), exact=True)
