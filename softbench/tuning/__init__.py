@@ -8,17 +8,17 @@ the agent's hyperparameters (``softbench.agents.hyperparameters``); ``tune`` doe
 ``softbench.tuning.study`` for the objective, sampler and pruner.
 """
 
-from softbench.tuning.study import DEFAULT_TRIALS
-from softbench.tuning.study import MAX_TRIALS
-from softbench.tuning.study import TuneSettings
-from softbench.tuning.study import adopt
+from softbench.tuning.definition import DEFAULT_TRIALS
+from softbench.tuning.definition import MAX_TRIALS
+from softbench.tuning.definition import TuneSettings
+from softbench.tuning.definition import default_storage
+from softbench.tuning.definition import settings
 from softbench.tuning.study import confirm
-from softbench.tuning.study import default_storage
 from softbench.tuning.study import run
-from softbench.tuning.study import settings
-from softbench.tuning.study import summary_path
 from softbench.tuning.study import tune
-from softbench.tuning.study import write_summary
+from softbench.tuning.summary_files import adopt
+from softbench.tuning.summary_files import summary_path
+from softbench.tuning.summary_files import write_summary
 
 __all__ = [
   "DEFAULT_TRIALS",
