@@ -112,8 +112,11 @@ def test_bad_steps_and_resets_get_clear_errors():
   env.reset(seed=0)
   with pytest.raises(ValueError, match="shape"):
     env.step(np.zeros((3, 2)))
+  before = env.tasks[0].observation_from(env.batch.poses([0])[0])
   with pytest.raises(ValueError, match="lie in"):
     env.step(np.full((2, 2), 3.0))
+  after = env.tasks[0].observation_from(env.batch.poses([0])[0])
+  assert env_checker.data_equivalence(before, after, exact=True)  # A refused step changes nothing.
   with pytest.raises(ValueError, match="reset_mask"):
     env.reset(options={"reset_mask": [True, False]})
   with pytest.raises(ValueError, match="seeds"):

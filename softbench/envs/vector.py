@@ -156,6 +156,7 @@ class SoftArmVectorEnv(gymnasium.vector.VectorEnv):
     if np.any(self._ended & ~resetting):
       raise RuntimeError("an arm's episode has ended; reset it (autoreset_mode DISABLED)")
     running = np.flatnonzero(~resetting)
+    self.batch.controls(actions[running], len(running))  # Refuses bad actions before any change.
     actions = np.asarray(actions, np.float64)
     targets = {arm: self.tasks[arm].targets_at(self.tasks[arm].steps_done) for arm in running}
     for arm in running:
