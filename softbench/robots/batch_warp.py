@@ -5,8 +5,8 @@ on the CPU (Warp's ``cpu`` device, for tests) the steps run one by one. MuJoCo W
 float32 and supports dense Jacobians only up to 60 degrees of freedom, so arms with more (the
 3-module tendon arms have 63) run with sparse ones: neither changes the physics beyond float32
 rounding. Measured against the serial path on the CPU device: 2e-8 m on tendon-3's tips after
-one control period from rest (``tests/test_batch.py`` holds every robot to
-``PARITY_TOLERANCE_M``).
+one control period from rest (``tests/test_batch.py`` holds tendon-1 and pneumatic-433 to
+``PARITY_TOLERANCE_M`` where MuJoCo Warp is installed).
 """
 
 import importlib.util
