@@ -67,9 +67,10 @@ def observation_in(named: dict, form: str) -> np.ndarray | dict:
 
 def errors(robot: robots.SoftArm, task, poses: np.ndarray, target: np.ndarray) -> dict[str, Any]:
   """``step``'s info: the errors of ``poses`` (num_modules, 6) reached by a step of ``task``
-  (a ``SoftArmTask``) against the ``target`` it showed before it, per scored module."""
+  (a ``SoftArmTask``) against the ``target`` it showed before it, per scored module. Leading
+  axes (many arms of one task) give errors with the same leading axes."""
   scored = tuple(task.scored_modules())
-  achieved = np.asarray(poses)[np.array(scored) - 1, : target.shape[-1]]
+  achieved = np.asarray(poses)[..., np.array(scored) - 1, : target.shape[-1]]
   info = {
     "scored_modules": scored,
     "position_error_mm": metrics.position_error_mm(achieved, target),

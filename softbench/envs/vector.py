@@ -166,13 +166,13 @@ class SoftArmVectorEnv(gymnasium.vector.VectorEnv):
     rewards = np.zeros(self.num_envs)
     infos: dict[str, Any] = {}
     ending = []
-    for arm, poses in zip(running, self.batch.poses(running)):
+    reached = self.batch.poses(running)
+    for arm, info, poses in zip(running, self._errors(running, reached, targets), reached):
       task = self.tasks[arm]
       task.after_step()
       rewards[arm] = task.reward_from(poses)
       self._observations[arm] = task.observation_from(poses)
       self._ended[arm] = task.get_termination(None) is not None
-      info = environment.errors(self.robot, task, poses, targets[arm])
       if self._ended[arm] and self.autoreset_mode == AutoresetMode.SAME_STEP:
         info = {"final_obs": self._single(self._observations[arm]), "final_info": info}
         ending.append(arm)
@@ -185,6 +185,24 @@ class SoftArmVectorEnv(gymnasium.vector.VectorEnv):
         infos = self._add_info(infos, {}, arm)
     terminated = np.zeros(self.num_envs, bool)
     return self._batched(self._observations), rewards, terminated, truncated, infos
+
+  def _errors(self, arms: np.ndarray, poses: np.ndarray, targets: dict) -> list[dict]:
+    """Each arm's ``environment.errors``, computed for all at once where the arms' tasks score
+    the same modules on targets of one shape (every arm of a task, as a rule; 260 us an arm
+    before, arm by arm)."""
+    tasks = [self.tasks[arm] for arm in arms]
+    shown = [targets[arm] for arm in arms]
+    alike = len({(task.scored_modules(), target.shape) for task, target in zip(tasks, shown)})
+    if alike != 1:
+      return [
+        environment.errors(self.robot, task, pose, target)
+        for task, pose, target in zip(tasks, poses, shown)
+      ]
+    batched = environment.errors(self.robot, tasks[0], poses, np.stack(shown))
+    return [
+      {key: value if key == "scored_modules" else value[index] for key, value in batched.items()}
+      for index in range(len(arms))
+    ]
 
   def _single(self, named: dict) -> np.ndarray | dict:
     return environment.observation_in(named, self._observation_form)
