@@ -139,15 +139,20 @@ class SoftArmTask(suite_base.Task):
     """Mean over scored modules of a tolerance reward on the distance of ``poses``
     (num_modules, 6), reached by the step just taken, to that step's target."""
     achieved = np.asarray(poses)[np.array(self.scored_modules()) - 1, :3]
-    distance = np.linalg.norm(achieved - self.targets_at(self._step - 1)[:, :3], axis=-1)
-    length = self.robot.length
-    return float(
-      np.mean(
-        rewards.tolerance(
-          distance,
-          bounds=(0.0, REWARD_TOLERANCE * length),
-          margin=REWARD_MARGIN * length,
-          sigmoid="long_tail",
-        )
-      )
-    )
+    return float(position_reward(achieved, self.targets_at(self._step - 1), self.robot.length))
+
+
+def position_reward(achieved: np.ndarray, target: np.ndarray, length: float) -> np.ndarray:
+  """``SoftArmTask.reward_from``'s reward of reached positions ``achieved`` (..., scored, 3)
+  against ``target`` (..., scored, 3 or 6) on an arm ``length`` (m) long, over any leading axes
+  (the arms of a batch)."""
+  distance = np.linalg.norm(achieved - target[..., :3], axis=-1)
+  return np.mean(
+    rewards.tolerance(
+      distance,
+      bounds=(0.0, REWARD_TOLERANCE * length),
+      margin=REWARD_MARGIN * length,
+      sigmoid="long_tail",
+    ),
+    axis=-1,
+  )
