@@ -4,6 +4,7 @@ rewards, ends and infos bit for bit, autoresets included, on every task with one
 family (as ``test_envs``), each pair under one of the three autoreset modes in turn.
 """
 
+import example_task
 import gymnasium
 from gymnasium.utils import env_checker
 from gymnasium.vector import AutoresetMode
@@ -133,3 +134,29 @@ def test_a_faulty_arm_through_the_generic_id_steps_as_its_serial_counterpart():
   assert env_checker.data_equivalence(batched.reset(seed=1), serial.reset(seed=1), exact=True)
   action = np.full(batched.action_space.shape, 0.8, np.float32)
   assert env_checker.data_equivalence(batched.step(action), serial.step(action), exact=True)
+
+
+class _HoldNearby(example_task.Hold):
+  """Hold, with a reward of its own (1 within 1 cm of the start, else 0), which a batch must ask
+  arm by arm."""
+
+  def reward_from(self, poses: np.ndarray) -> float:
+    return float(np.linalg.norm(poses[:, :3] - self._start[:, :3], axis=-1).max() < 0.01)
+
+
+@pytest.mark.parametrize("build", [example_task.Hold, _HoldNearby], ids=["hold", "own-reward"])
+def test_a_users_task_runs_in_the_batch_as_in_sync_vectorization(build, restored_tasks):
+  """A task registered from outside softbench (``example_task.Hold``: its targets come from the
+  start's poses, ``episode_started``), also with its own reward."""
+  suite.register(
+    "hold",
+    suite.TaskEntry(
+      build=build, tags=(), description="", paper_robot="tendon-1", length_option="steps"
+    ),
+  )
+  options = {"robot": "tendon-1", "task": "hold", "steps": 1}
+  batched = gymnasium.make_vec(softbench.envs.ANY_ROBOT_ID, 2, backend="cpu", **options)
+  serial = gymnasium.make_vec(softbench.envs.ANY_ROBOT_ID, 2, vectorization_mode="sync", **options)
+  assert env_checker.data_equivalence(batched.reset(seed=2), serial.reset(seed=2), exact=True)
+  for action in (np.zeros((2, 2), np.float32), np.full((2, 2), 0.3, np.float32)):
+    assert env_checker.data_equivalence(batched.step(action), serial.step(action), exact=True)
