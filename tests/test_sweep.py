@@ -432,3 +432,18 @@ def test_the_cli_refuses_bad_protocol_options_in_one_line(argv, message, tmp_pat
   error = capsys.readouterr().err
   assert message in error and error.count("\n") == 1
   assert not ray.is_initialized()
+
+
+def test_a_local_ray_that_does_not_start_is_a_one_line_failure(tmp_path, monkeypatch, capsys):
+  """Seen on 2026-12-07: Ray's node timed out at startup (its processes were held up) and the
+  sweep ended in Ray's traceback."""
+
+  def timed_out(*args, **kwargs):
+    raise Exception("The current node timed out during startup. This could happen because ...")
+
+  monkeypatch.setattr(ray, "init", timed_out)
+  argv = ["sweep", "--robots", "tendon-1", "--tasks", "circle", "--agents", "zero"]
+  assert cli.main([*argv, "--profile", "tiny", "--results", str(tmp_path / "results")]) == 1
+  error = capsys.readouterr().err
+  assert "the local Ray did not start (The current node timed out during startup." in error
+  assert error.count("\n") == 1 and not ray.is_initialized()

@@ -20,6 +20,7 @@ _RUN_FAILURES = (
   "softbench.runners.continual:ForgettingDetected",
   "softbench.runners.zoo_verification:ZooMismatch",
   "softbench.sweep:SweepFailed",
+  "softbench.sweep.cluster:ClusterUnavailable",
 )
 
 

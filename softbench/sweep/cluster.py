@@ -28,6 +28,11 @@ _LOOPBACK = ("localhost", "127.0.0.1", "::1")
 _NODE_FACTS = ray.remote(num_cpus=1)(tasks.node_facts)
 
 
+class ClusterUnavailable(RuntimeError):
+  """The sweep's own local Ray did not start (seen when its processes were held up at startup:
+  "The current node timed out during startup")."""
+
+
 @contextlib.contextmanager
 def connected(address: str | None) -> Iterator[None]:
   """Within the block, Ray: the caller's if it started one, else the cluster at ``address``, else
@@ -40,7 +45,14 @@ def connected(address: str | None) -> Iterator[None]:
   if address is None:
     before = guard.children(os.getpid())
     # "local": a Ray of its own even where RAY_ADDRESS or a running `ray start` names another.
-    ray.init(address="local", num_cpus=os.cpu_count(), include_dashboard=False)
+    try:
+      ray.init(address="local", num_cpus=os.cpu_count(), include_dashboard=False)
+    except Exception as error:  # Ray raises a bare Exception when its node does not come up.
+      ray.shutdown()
+      raise ClusterUnavailable(
+        f"the local Ray did not start ({first_line(error)}); run the same command again: the "
+        "records written so far are kept"
+      ) from None
     local_ray = guard.start(guard.children(os.getpid()) - before)  # Ends with this process.
   else:
     _check_answers(address)
