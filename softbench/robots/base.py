@@ -51,6 +51,26 @@ def action_to_ctrl(action_map: np.ndarray, action: np.ndarray) -> np.ndarray:
   return np.where(a < 0, below, above)
 
 
+def checked_actions(actions, shape: tuple[int, ...], name: str = "action") -> np.ndarray:
+  """``actions`` as floats of ``shape``, clipped to [-1, 1] within rounding.
+
+  Raises:
+    ValueError: not real numbers (bool, complex, text), another shape, or an entry that is NaN,
+      infinite or outside [-1, 1] (one line, naming ``name``).
+  """
+  given = np.asarray(actions)
+  if given.dtype.kind not in "iuf":  # Casting would drop an imaginary part or read True as 1.
+    raise ValueError(f"{name} must hold real numbers, got an array of {given.dtype}")
+  values = given.astype(float)
+  if values.shape != tuple(shape):
+    raise ValueError(f"{name} must have shape {tuple(shape)}, got {values.shape}")
+  if not np.all(np.isfinite(values)):
+    raise ValueError(f"{name} contains NaN or infinite values: {values.tolist()}")
+  if np.any(np.abs(values) > 1.0 + 1e-9):
+    raise ValueError(f"{name} entries must lie in [-1, 1], got {values.tolist()}")
+  return np.clip(values, -1.0, 1.0)
+
+
 class SoftArm(abc.ABC):
   """Base of the frozen spec dataclasses of every robot family.
 

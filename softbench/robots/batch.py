@@ -89,16 +89,8 @@ class ArmBatch(abc.ABC):
     Raises:
       ValueError: a wrong shape, or an entry NaN, infinite or outside [-1, 1] (one line).
     """
-    given = np.asarray(actions)
-    if given.dtype.kind not in "iuf":
-      raise ValueError(f"actions must hold real numbers, got an array of {given.dtype}")
-    actions = given.astype(np.float64)
-    expected = (count, self.robot.action_dim)
-    if actions.shape != expected:
-      raise ValueError(f"actions must have shape {expected}, got {actions.shape}")
-    if not np.all(np.isfinite(actions)) or np.any(np.abs(actions) > 1.0 + 1e-9):
-      raise ValueError("actions must be finite and lie in [-1, 1]")
-    return base.action_to_ctrl(self._action_map, np.clip(actions, -1.0, 1.0))
+    actions = base.checked_actions(actions, (count, self.robot.action_dim), "actions")
+    return base.action_to_ctrl(self._action_map, actions)
 
   @abc.abstractmethod
   def reset(self, arms: Arms = None) -> None:
@@ -253,14 +245,8 @@ class RolloutArmBatch(ArmBatch):
       raise FloatingPointError(f"{self.robot.name}: simulation unstable")
 
   def poses(self, arms: Arms = None) -> np.ndarray:
-    indices = self.arm_indices(arms)
-    poses = np.empty((len(indices), len(self._sites), POSE_SIZE))
-    for pose, state in zip(poses, self._states[indices]):
-      mujoco.mj_setState(self.model, self._scratch, state, STATE_SPEC)
-      mujoco.mj_kinematics(self.model, self._scratch)
-      pose[:, :3] = self._scratch.site_xpos[self._sites]
-      pose[:, 3:] = self._scratch.site_xmat[self._sites].reshape(-1, 3, 3)[:, :, 2]
-    return poses
+    states = self._states[self.arm_indices(arms)]
+    return poses_of_states(self.model, self._scratch, self._sites, states)
 
   def set_time(self, time: float, arms: Arms = None) -> None:
     self._states[self.arm_indices(arms), 0] = time  # Time leads a full physics state.
@@ -276,6 +262,20 @@ class RolloutArmBatch(ArmBatch):
 
   def close(self) -> None:
     self._runner.close()
+
+
+def poses_of_states(
+  model: mujoco.MjModel, data: mujoco.MjData, sites: np.ndarray, states: np.ndarray
+) -> np.ndarray:
+  """(len(states), len(sites), 6): the tip sites' positions (m) and z-axes in full physics
+  states (``STATE_SPEC``), each set in ``data`` in turn."""
+  poses = np.empty((len(states), len(sites), POSE_SIZE))
+  for pose, state in zip(poses, states):
+    mujoco.mj_setState(model, data, state, STATE_SPEC)
+    mujoco.mj_kinematics(model, data)
+    pose[:, :3] = data.site_xpos[sites]
+    pose[:, 3:] = data.site_xmat[sites].reshape(-1, 3, 3)[:, :, 2]
+  return poses
 
 
 def cpu(

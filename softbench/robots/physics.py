@@ -52,17 +52,8 @@ class SoftArmPhysics(mujoco.Physics):
       ValueError: not real numbers (bool, complex, text), wrong shape, or an action entry that
         is NaN, infinite or outside [-1, 1].
     """
-    given = np.asarray(action)
-    if given.dtype.kind not in "iuf":  # Casting would drop an imaginary part or read True as 1.
-      raise ValueError(f"action must hold real numbers, got an array of {given.dtype}")
-    action = given.astype(float)
-    if action.shape != (self.action_dim,):
-      raise ValueError(f"action must have shape ({self.action_dim},), got {action.shape}")
-    if not np.all(np.isfinite(action)):
-      raise ValueError(f"action contains NaN or infinite values: {action.tolist()}")
-    if np.any(np.abs(action) > 1.0 + 1e-9):
-      raise ValueError(f"action entries must lie in [-1, 1], got {action.tolist()}")
-    self.data.ctrl[:] = base.action_to_ctrl(self.action_map, np.clip(action, -1.0, 1.0))
+    action = base.checked_actions(action, (self.action_dim,))
+    self.data.ctrl[:] = base.action_to_ctrl(self.action_map, action)
 
   def step(self, nstep: int = 1) -> None:
     super().step(nstep)

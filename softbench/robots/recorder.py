@@ -37,9 +37,9 @@ class PoseRecorder:
     self.model = model if model is not None else robot.compile()
     self.steps_per_action = int(round(robot.control_timestep / self.model.opt.timestep))
     self._scratch = mujoco.MjData(self.model)
-    self._sites = [
-      self.model.site(chain.tip_site_name(k)).id for k in range(1, robot.num_modules + 1)
-    ]
+    self._sites = np.array(
+      [self.model.site(chain.tip_site_name(k)).id for k in range(1, robot.num_modules + 1)]
+    )
 
   @property
   def state_size(self) -> int:
@@ -56,12 +56,7 @@ class PoseRecorder:
     """(..., num_modules, 6) module poses of full physics states (..., state_size)."""
     states = np.asarray(states, dtype=float)
     flat = states.reshape(-1, self.state_size)
-    poses = np.empty((len(flat), len(self._sites), POSE_SIZE))
-    for index, state in enumerate(flat):
-      mujoco.mj_setState(self.model, self._scratch, state, STATE_SPEC)
-      mujoco.mj_kinematics(self.model, self._scratch)
-      poses[index, :, :3] = self._scratch.site_xpos[self._sites]
-      poses[index, :, 3:] = self._scratch.site_xmat[self._sites].reshape(-1, 3, 3)[:, :, 2]
+    poses = batch.poses_of_states(self.model, self._scratch, self._sites, flat)
     return poses.reshape(states.shape[:-1] + poses.shape[1:])
 
   def record(
