@@ -1,4 +1,5 @@
-"""``softbench run``: an agent scored on a task over seeds, or ``--protocol exp1s``."""
+"""``softbench run``: an agent scored on a task over seeds, ``--protocol exp1s``, or ``--protocol
+continual``: a continual strategy learning a stream."""
 
 import argparse
 import pathlib
@@ -25,6 +26,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
   from softbench import agents
   from softbench import robots
   from softbench import suite
+  from softbench.continual import strategies
+  from softbench.continual import streams
+  from softbench.records import continual as continual_records
   from softbench.records import exp1s as exp1s_records
   from softbench.runners import adaptive
 
@@ -34,16 +38,26 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     help=f"{exp1s_records.PROTOCOL}: SMPL learns tendon-1 .. "
     f"tendon-5 (or another --family's arms) in sequence; "
     f"prints the paper's Exp1S table and the forgetting "
-    f"matrix",
+    f"matrix. {continual_records.PROTOCOL}: the continual strategy --agent learns --stream "
+    f"stage by stage; prints the error matrix, forgetting and each stage's training",
+  )
+  parser.add_argument(
+    "--stream",
+    help=f"with --protocol {continual_records.PROTOCOL}: one of {', '.join(streams.STREAMS)}",
   )
   parser.add_argument(
     "--family",
-    help=f"with --protocol {exp1s_records.PROTOCOL}: the tendon "
-    f"family whose arms 1 .. 5 SMPL learns, one of "
+    help=f"with --protocol {exp1s_records.PROTOCOL} or {continual_records.PROTOCOL}: the tendon "
+    f"family of the arms, one of "
     f"{', '.join(robots.TENDON_FAMILIES)} (default "
     f"{exp1s_records.DEFAULT_FAMILY})",
   )
-  parser.add_argument("--agent", required=True, help=f"one of {', '.join(agents.AGENTS)}")
+  parser.add_argument(
+    "--agent",
+    required=True,
+    help=f"one of {', '.join(agents.AGENTS)}; with --protocol {continual_records.PROTOCOL}, "
+    f"a strategy: {', '.join(strategies.STRATEGIES)}",
+  )
   parser.add_argument(
     "--robot", help="default: the task's robot in the paper (tendon-3; pneumatic-433 for reach)"
   )
@@ -114,7 +128,9 @@ def handle(args: argparse.Namespace) -> None:
   if args.protocol is not None:
     return _run_protocol(args)
   if args.family is not None:
-    raise ValueError("--family goes with --protocol exp1s; a task's robot is --robot")
+    raise ValueError("--family goes with --protocol exp1s or continual; a task's robot is --robot")
+  if args.stream is not None:
+    raise ValueError("--stream goes with --protocol continual")
   if args.task is None:
     raise ValueError("softbench run needs --task TASK (or --protocol exp1s)")
   settings = run_settings.settings(
@@ -146,9 +162,14 @@ def handle(args: argparse.Namespace) -> None:
 
 
 def _run_protocol(args: argparse.Namespace) -> None:
+  from softbench.records import continual as continual_records
   from softbench.runners import continual
   from softbench.runners import saving
 
+  if args.protocol == continual_records.PROTOCOL:
+    return _run_stream(args)
+  if args.stream is not None:
+    raise ValueError(f"--stream goes with --protocol {continual_records.PROTOCOL}")
   settings = continual.settings(
     args.protocol,
     args.agent,
@@ -167,6 +188,29 @@ def _run_protocol(args: argparse.Namespace) -> None:
     pathlib.Path(args.results),
     arguments.json_copy(args),
     lambda files: continual.finish(record, files),
+  )
+
+
+def _run_stream(args: argparse.Namespace) -> None:
+  from softbench.runners import continual_stream
+  from softbench.runners import saving
+
+  settings = continual_stream.settings(
+    args.agent,
+    args.stream,
+    args.profile,
+    args.family,
+    args.seeds,
+    args.eval,
+    arguments.flags_given(args, _TASK_RUN_OPTIONS),
+  )
+  record = continual_stream.execute(settings, workers=args.workers, keep_seeds=True)
+  saving.save(
+    continual_stream,
+    record,
+    pathlib.Path(args.results),
+    arguments.json_copy(args),
+    lambda files: continual_stream.finish(settings, record, files),
   )
 
 

@@ -1,12 +1,15 @@
 """Result records: their JSON Schema, their integrity hash, and checked writing and reading.
 
 The package owns every record format and imports no torch: run records here, Exp1S records in
-``records.exp1s``, the fields both share in ``records.fields``, provenance in
+``records.exp1s``, continual ones in ``records.continual``, the fields all share in
+``records.fields``, provenance in
 ``records.provenance``. Runners write through ``write``; the leaderboard reads through ``read``.
 
 A record is one ``softbench run`` (format ``softbench-result``, version 2): provenance, settings
 and per-seed errors; or one ``softbench run --protocol exp1s`` (format
-``softbench-exp1s-result``, version 2, schema and checks in ``records.exp1s``). Reading and
+``softbench-exp1s-result``, version 2, schema and checks in ``records.exp1s``); or one
+``softbench run --protocol continual`` (format ``softbench-continual-result``, version 1,
+``records.continual``). Reading and
 writing dispatch on ``format``. ``write`` seals a record with ``sha256``, the hash of the
 canonical JSON of everything else in it, and ``read`` refuses a file that is not valid JSON, does
 not match its kind's schema (``schema()``, ``records.exp1s.schema()``, JSON Schema draft
@@ -36,6 +39,7 @@ from jsonschema import exceptions as schema_exceptions
 from softbench import robots
 from softbench import storage
 from softbench import suite
+from softbench.records import continual as continual_records
 from softbench.records import exp1s as exp1s_records
 from softbench.records import fields as record_fields
 from softbench.records.fields import METRICS
@@ -192,6 +196,12 @@ def kinds() -> dict[str, Kind]:
     FORMAT: Kind(FORMAT, VERSION, schema, _check_consistency),
     exp1s_records.FORMAT: Kind(
       exp1s_records.FORMAT, exp1s_records.VERSION, exp1s_records.schema, exp1s_records.check
+    ),
+    continual_records.FORMAT: Kind(
+      continual_records.FORMAT,
+      continual_records.VERSION,
+      continual_records.schema,
+      continual_records.check,
     ),
   }
 

@@ -16,6 +16,7 @@ import mujoco
 import numpy as np
 
 from softbench.robots import faults as fault_model
+from softbench.robots import payload as payload_model
 from softbench.robots import versions
 
 ACTION_MAP_NAME = "action_map"
@@ -75,10 +76,12 @@ class SoftArm(abc.ABC):
   """Base of the frozen spec dataclasses of every robot family.
 
   Every family has a ``faults`` field: a tuple of ``softbench.robots.faults.Fault`` (empty for a
-  healthy robot), applied to the actuators' gains when the MJCF is built.
+  healthy robot), applied to the actuators' gains when the MJCF is built, and a ``payload``
+  field: the mass at its tip (kg, ``softbench.robots.payload``; 0 for none).
   """
 
   faults: tuple[fault_model.Fault, ...] = ()
+  payload: float = 0.0
 
   @property
   @abc.abstractmethod
@@ -185,6 +188,7 @@ class SoftArm(abc.ABC):
     spec.compiler.degree = False
     self._build(spec)
     fault_model.apply(spec, self)
+    payload_model.apply(spec, self)
     spec.add_numeric(name=ACTION_MAP_NAME, data=self.action_map().ravel().tolist())
     return spec
 

@@ -126,13 +126,13 @@ def _coupling(robot: base.SoftArm) -> list[str]:
 
 
 def spec_fields(robot: base.SoftArm):
-  """(field, printable value) of every field of the robot's spec; ``faults`` only when there
-  are some (exported models are healthy)."""
+  """(field, printable value) of every field of the robot's spec; ``faults`` and ``payload``
+  only when there are some (exported models are healthy and carry nothing)."""
   for field in (entry.name for entry in dataclasses.fields(robot)):
     value = getattr(robot, field)
-    if field == "faults":
+    if field in ("faults", "payload"):
       if value:
-        yield field, ", ".join(map(str, value))
+        yield field, (", ".join(map(str, value)) if field == "faults" else f"{value:g} kg")
       continue
     yield field, (f"{value:g}" if isinstance(value, float) else value)
 

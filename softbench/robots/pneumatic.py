@@ -18,6 +18,7 @@ import numpy as np
 from softbench.robots import base
 from softbench.robots import chain
 from softbench.robots import faults as fault_model
+from softbench.robots import payload as payload_model
 
 MODULE_LENGTH = 0.08  # (m) Paper: "Each actuator is 80mm long".
 BELLOWS_PER_MODULE = (4, 3, 3)  # Paper: 4 at 90 degrees at the base, then 3 at 120 degrees.
@@ -66,6 +67,7 @@ class PneumaticArm(base.SoftArm):
     control_period: Time between two actions (s); the paper actuates the robot at 5 Hz.
     faults: Faulty bellows (``softbench.robots.faults``; actuator i of a module is its bellows
       i + 1); empty for a healthy arm.
+    payload: Mass carried at the tip (kg; ``softbench.robots.payload``); 0 for none.
   """
 
   module_length: float = MODULE_LENGTH
@@ -85,6 +87,7 @@ class PneumaticArm(base.SoftArm):
   timestep: float = 1.0e-3
   control_period: float = 0.2
   faults: tuple[fault_model.Fault, ...] = ()
+  payload: float = 0.0
 
   def __post_init__(self):
     for field in (
@@ -112,6 +115,7 @@ class PneumaticArm(base.SoftArm):
         f"segments_per_module must be a positive integer, got {self.segments_per_module!r}"
       )
     fault_model.check(self, self.faults)
+    payload_model.check(self.payload)
 
   @property
   def name(self) -> str:

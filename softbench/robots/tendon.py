@@ -30,6 +30,7 @@ import numpy as np
 from softbench.robots import base
 from softbench.robots import chain
 from softbench.robots import faults as fault_model
+from softbench.robots import payload as payload_model
 from softbench.robots import versions
 
 MODULE_LENGTH = 0.05  # (m) Paper: "Each module has a length of 50 mm".
@@ -82,6 +83,7 @@ class CableDrivenArm(base.SoftArm):
     control_period: Time between two actions (s).
     faults: Faulty cables (``softbench.robots.faults``; actuator i of a module is cable
       ``xpos``, ``ypos``, ``xneg``, ``yneg`` for i = 0 .. 3); empty for a healthy arm.
+    payload: Mass carried at the tip (kg; ``softbench.robots.payload``); 0 for none.
   """
 
   num_modules: int = 3
@@ -101,6 +103,7 @@ class CableDrivenArm(base.SoftArm):
   timestep: float = 4.0e-3
   control_period: float = 1.0
   faults: tuple[fault_model.Fault, ...] = ()
+  payload: float = 0.0
 
   FAMILY: ClassVar[str]  # Registry names are FAMILY-N.
   _POSITIVE_FIELDS: ClassVar[tuple[str, ...]] = ()  # A family's own fields that must be > 0.
@@ -142,6 +145,7 @@ class CableDrivenArm(base.SoftArm):
     if self.backbone == "cable" and not versions.cable_plugin_available():
       raise ValueError(versions.CABLE_PLUGIN_MISSING)
     fault_model.check(self, self.faults)
+    payload_model.check(self.payload)
 
   @classmethod
   def from_name(cls, name: str, **overrides) -> "CableDrivenArm":

@@ -81,9 +81,9 @@ def settings(
   """
   if protocol_name != PROTOCOL:
     raise ValueError(
-      f"unknown protocol {protocol_name!r}; {PROTOCOL} is the one with a table of its own "
-      f"(exp2s and exp2r are the tasks on tendon-3 and pneumatic-433: softbench run --task TASK "
-      f"--agent AGENT)"
+      f"unknown protocol {protocol_name!r}; choose {PROTOCOL} (SMPL's Exp1S table) or "
+      f"continual (--stream STREAM --agent STRATEGY); exp2s and exp2r are the tasks on "
+      f"tendon-3 and pneumatic-433: softbench run --task TASK --agent AGENT"
     )
   if agent != "smpl":
     raise ValueError(
@@ -182,7 +182,8 @@ def check_no_forgetting(matrix: np.ndarray) -> None:
         )
 
 
-def _end_effector_scores(episode: episodes.Episode, length: float) -> dict:
+def end_effector_scores(episode: episodes.Episode, length: float) -> dict:
+  """The end effector's errors of ``episode`` (each metric measured, mean over its steps)."""
   score = episode.score(length)
   return {name: getattr(score, name)[-1].mean for name in METRICS if getattr(score, name)}
 
@@ -269,7 +270,7 @@ def score_seed(
             arm, task, seed=seed, **suite.length_options(task, profile.episode_length)
           )
           episode = evaluation.run_episode(env, agent, task, show_progress)
-          entry = _end_effector_scores(episode, arm.length)
+          entry = end_effector_scores(episode, arm.length)
           episode_snapshots.save_scores(path, entry, subject)
         scores[loop][task].append(entry)
   tip = [entry["normalised_tip_percent"] for entry in scores["closed"][FORGETTING_TASK]]

@@ -1,0 +1,202 @@
+"""Continual strategies on streams (``softbench run --protocol continual``), over every registered
+strategy and stream: each learns a tiny two-stage stream (tendon-1, then tendon-2) and is scored
+in physics after every stage; SMPL forgets nothing to the bit; finetuning forgets and replay and
+EWC forget less; an outside strategy and stream join by ``register``; bad input is one line."""
+
+import dataclasses
+import json
+
+import example_strategy
+import numpy as np
+import pytest
+
+from softbench import cli
+from softbench import profiles
+from softbench import records
+from softbench.continual import learning as continual_learning
+from softbench.continual import metrics as continual_metrics
+from softbench.continual import strategies
+from softbench.continual import streams
+from softbench.continual.strategies import base as strategy_base
+from softbench.data import views
+from softbench.records import continual as continual_records
+from softbench.records.fields import METRICS
+from softbench.runners import continual as exp1s_runner
+from softbench.runners import continual_stream
+
+PAIR = streams.Stream(
+  "pair", "tendon-1, then tendon-2", lambda family: streams._arms(family, (1, 2))
+)
+TINY = profiles.get("tiny")
+# Long enough for a shared network to learn each stage, so that learning the second one can
+# undo the first (2 epochs hardly move it); 10 epochs of the tiny dataset take about 4 s.
+LEARNING = dataclasses.replace(TINY, max_epochs=10, patience=10)
+
+
+@pytest.fixture
+def registries(monkeypatch):
+  """The stream and strategy registries as they are, restored after the test."""
+  monkeypatch.setattr(streams, "_STREAMS", dict(streams._STREAMS))
+  monkeypatch.setattr(streams, "STREAMS", streams.STREAMS)
+  monkeypatch.setattr(strategies, "_STRATEGIES", dict(strategies._STRATEGIES))
+  monkeypatch.setattr(strategies, "STRATEGIES", strategies.STRATEGIES)
+
+
+@pytest.fixture
+def pair(registries, tmp_path, babbled_home):
+  """``PAIR`` registered, in a data home with tendon-1's and tendon-2's tiny datasets."""
+  for robot in ("tendon-1", "tendon-2"):
+    babbled_home(tmp_path / "home", robot)
+  streams.register(PAIR)
+  return PAIR
+
+
+def seed_entry(strategy: str, profile: profiles.Profile = TINY) -> dict:
+  return continual_stream.run_seed(
+    0, continual_stream.ContinualSettings(strategy, "pair", "tendon", profile, 1)
+  )
+
+
+@pytest.mark.parametrize("name", streams.STREAMS)
+@pytest.mark.parametrize("family", ["tendon", "tendon-local"])
+def test_every_stream_is_a_sequence_of_configurations_one_view_reads(name, family):
+  stream = streams.get(name)
+  configurations = stream.configurations(family)
+  assert len(configurations) >= 2
+  assert len({configuration.label for configuration in configurations}) == len(configurations)
+  pose_sizes = {views.View.end_effector(c.robot).pose_size for c in configurations}
+  assert len(pose_sizes) == 1
+  assert len({c.robot.physics_sha256() for c in configurations}) == len(configurations)
+  for configuration in configurations:
+    assert configuration.robot.name.startswith(f"{family}-")
+    assert json.loads(json.dumps(configuration.describe())) == configuration.describe()
+
+
+def test_payload_and_degrade_change_the_physics_as_described():
+  loaded = streams.get("payload").configurations()
+  empty = loaded[0].robot.mass()
+  for configuration, grams in zip(loaded, streams.PAYLOADS_G):
+    assert configuration.robot.mass() - empty == pytest.approx(grams / streams.GRAMS_PER_KG)
+  degraded = streams.get("degrade").configurations()
+  for configuration, gain in zip(degraded, streams.DEGRADE_GAINS):
+    faults = configuration.robot.faults
+    assert all(fault.gain == gain and fault.module == streams.DEGRADED_MODULE for fault in faults)
+    assert len(faults) == (0 if gain == 1.0 else streams.CABLES_PER_MODULE)
+
+
+@pytest.mark.parametrize("name", strategies.STRATEGIES)
+def test_every_strategy_learns_a_two_stage_stream_scored_in_physics(name, pair):
+  run = continual_stream.ContinualSettings(name, "pair", "tendon", TINY, 1)
+  record = records.seal(continual_stream.execute(run, show_progress=False, workers=1))
+  records.validate(record, name)  # Schema, hash and the continual checks.
+  (seed,) = record["per_seed"]
+  first, second = seed["stages"]
+  assert [len(stage["scores"]) for stage in seed["stages"]] == [1, 2]
+  assert all(
+    np.isfinite(score[m]) for s in seed["stages"] for score in s["scores"] for m in METRICS
+  )
+  continual = strategies.strategy_class(name).continual
+  for stage in seed["stages"]:
+    assert stage["parameters"] > 0 and stage["carried_values"] >= stage["parameters"]
+    if continual:
+      assert max(stage["trained_on"], default=0) <= stage["stage"]
+  if not continual:  # Every stage's data at the first stage.
+    assert first["trained_on"] == [0, 1]
+  matrix = continual_metrics.error_matrix(seed)
+  assert np.isnan(matrix[0, 1]) and np.all(np.isfinite(matrix[np.tril_indices(2)]))
+  table = continual_stream.table(record)
+  assert "average final error" in table and "forgetting" in table
+
+
+def test_smpl_forgets_nothing_to_the_bit(pair):
+  first, second = seed_entry("smpl", LEARNING)["stages"]
+  assert second["scores"][0] == first["scores"][0]
+  assert second["model_pose_mse"][0] == first["model_pose_mse"][0]
+  assert second["model_action_mse"][0] == first["model_action_mse"][0]
+  assert second["parameters_trained"] < second["parameters"]  # The new column only.
+
+
+def test_finetune_forgets_and_replay_and_ewc_forget_less(pair):
+  rises = {}
+  for name in ("finetune", "replay", "ewc"):
+    first, second = seed_entry(name, LEARNING)["stages"]
+    rises[name] = {
+      "physics_mm": second["scores"][0]["position_mm"] - first["scores"][0]["position_mm"],
+      "action_mse": second["model_action_mse"][0] - first["model_action_mse"][0],
+    }
+  for measure, rise in rises["finetune"].items():
+    assert rise > 0, (measure, rises)
+    assert rises["replay"][measure] < rise and rises["ewc"][measure] < rise, (measure, rises)
+
+
+def test_an_outside_strategy_and_stream_run_from_the_command_line(
+  registries, tmp_path, babbled_home, capsys
+):
+  babbled_home(tmp_path / "home", "tendon-1")
+  strategies.register("first-only", example_strategy.ENTRY)
+  streams.register(example_strategy.LOADED)
+  results = tmp_path / "results"
+  argv = ["run", "--protocol", "continual", "--stream", "loaded-pair", "--agent", "first-only"]
+  argv += ["--profile", "tiny", "--seeds", "1", "--results", str(results)]
+  assert cli.main(argv) == 0
+  assert "first-only on stream loaded-pair" in capsys.readouterr().out
+  (path,) = results.glob("first-only-continual-loaded-pair-tiny-*.json")
+  record = records.read(path)
+  assert [c["payload_kg"] for c in record["configurations"]] == list(example_strategy.PAYLOADS_KG)
+  first, second = record["per_seed"][0]["stages"]
+  assert second["trained_on"] == [] and second["parameters_trained"] == 0
+  assert path.with_name(f"{path.stem}-matrix.png").stat().st_size > 0
+
+
+@pytest.mark.parametrize(
+  "flags, message",
+  [
+    (["--agent", "smpl"], "needs --stream STREAM"),
+    (["--stream", "sideways", "--agent", "smpl"], "unknown stream 'sideways'"),
+    (["--stream", "grow", "--agent", "lstm"], "unknown continual strategy 'lstm'"),
+    (["--stream", "grow", "--agent", "first-only"], "it needs one action size"),
+    (["--stream", "grow", "--agent", "ewc", "--family", "rope"], "unknown tendon family 'rope'"),
+    (["--stream", "grow", "--agent", "ewc", "--task", "spiral"], "drop --task"),
+    (["--stream", "grow", "--agent", "ewc", "--eval", "model"], "drop --eval"),
+    (["--stream", "grow", "--agent", "ewc", "--seeds", "0"], "seeds"),
+  ],
+)
+def test_bad_continual_input_is_one_line_and_exit_2(registries, flags, message, capsys):
+  strategies.register("first-only", example_strategy.ENTRY)
+  assert cli.main(["run", "--protocol", "continual", *flags]) == 2
+  err = capsys.readouterr().err.strip().splitlines()
+  assert len(err) == 1 and message in err[0], err
+
+
+def test_stream_without_its_protocol_is_one_line(capsys):
+  assert cli.main(["run", "--task", "spiral", "--agent", "zero", "--stream", "grow"]) == 2
+  assert "--stream goes with --protocol continual" in capsys.readouterr().err
+
+
+def test_registries_refuse_taken_and_malformed_names(registries):
+  with pytest.raises(ValueError, match="registered already"):
+    streams.register(streams.get("grow"))
+  with pytest.raises(ValueError, match="lowercase"):
+    strategies.register("Two Words", example_strategy.ENTRY)
+  with pytest.raises(ValueError, match="unknown task"):
+    streams.register(dataclasses.replace(PAIR, task="juggling"))
+
+
+def test_the_continual_figures_follow_their_definitions():
+  nan = np.nan
+  errors = np.array([[2.0, nan, nan], [5.0, 4.0, nan], [3.0, 6.0, 1.0]])
+  assert continual_metrics.average_final(errors) == pytest.approx(10 / 3)
+  assert continual_metrics.forgetting_per_configuration(errors).tolist() == [3.0, 2.0]
+  reference = np.array([[2.0, nan, nan], [2.0, 8.0, nan], [2.0, 8.0, 2.0]])
+  assert continual_metrics.transfer_per_stage(errors, reference).tolist() == [0.5, 0.5]
+  assert continual_metrics.curve_area([4.0, 2.0, 3.0], 5) == pytest.approx((4 + 2 * 4) / 5)
+  assert continual_records.PROTOCOL == "continual"
+
+
+def test_smpl_on_a_growing_stream_is_exp1s(pair, two_stages):
+  # Exp1S (shortened to tendon-1, tendon-2 by two_stages) trains the same network, to the bit.
+  exp1s = exp1s_runner.build(0, TINY)
+  *_, (strategy, _, _) = continual_learning.learn("smpl", PAIR, "tendon", 0, TINY)
+  assert strategy_base.tensors_digest(strategy.module.network.state_dict()) == (
+    strategy_base.tensors_digest(exp1s.network.state_dict())
+  )
