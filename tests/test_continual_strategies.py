@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from softbench import cli
+from softbench import leaderboard
 from softbench import profiles
 from softbench import records
 from softbench.continual import learning as continual_learning
@@ -19,6 +20,9 @@ from softbench.continual import strategies
 from softbench.continual import streams
 from softbench.continual.strategies import base as strategy_base
 from softbench.data import views
+from softbench.leaderboard import continual_board
+from softbench.leaderboard import ranking
+from softbench.leaderboard import text as leaderboard_text
 from softbench.records import continual as continual_records
 from softbench.records.fields import METRICS
 from softbench.runners import continual as exp1s_runner
@@ -200,3 +204,31 @@ def test_smpl_on_a_growing_stream_is_exp1s(pair, two_stages):
   assert strategy_base.tensors_digest(strategy.module.network.state_dict()) == (
     strategy_base.tensors_digest(exp1s.network.state_dict())
   )
+
+
+def test_the_leaderboard_shows_a_table_per_stream_with_forward_transfer(
+  pair, tmp_path, assert_regenerates_identically
+):
+  results = tmp_path / "results"
+  for name in ("finetune", strategies.REFERENCE):
+    run = continual_stream.ContinualSettings(name, "pair", "tendon", TINY, 2)
+    record = continual_stream.execute(run, show_progress=False, workers=1)
+    records.write_new(record, continual_stream.record_path(record, results))
+  board = leaderboard.build(results)
+  (group,) = board.continual
+  assert group.title == "Continual · pair (tendon), profile tiny"
+  assert {entry.label for entry in group.entries} == {"finetune", strategies.REFERENCE}
+  rows = {row[0]: row for row in continual_board.table(group).rows}
+  assert rows[strategies.REFERENCE][5] == "-" and rows["finetune"][5] != "-"
+  finetune = next(entry for entry in group.entries if entry.label == "finetune")
+  expected = continual_metrics.transfer(finetune.record, group.reference.record)
+  assert rows["finetune"][5].startswith(
+    ranking.mean_and_std(ranking.Estimate.of([v * 100 for v in expected["forward_transfer"]]))
+  )
+  printed = leaderboard_text.report(board, results)
+  assert group.title in printed and "forward transfer (%)" in printed
+  markdown, html, _ = leaderboard.write(board, results, tmp_path / "site")
+  for page in (markdown, html):
+    text = page.read_text()
+    assert group.title in text and "normalised tip error (%) of each configuration" in text
+  assert_regenerates_identically(results, tmp_path)

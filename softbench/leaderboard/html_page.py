@@ -20,6 +20,7 @@ import numpy as np
 from softbench import agents
 from softbench import profiles
 from softbench.leaderboard import aggregate
+from softbench.leaderboard import continual_board
 from softbench.leaderboard import csv_table
 from softbench.leaderboard import exp1s_board
 from softbench.leaderboard import links
@@ -295,10 +296,9 @@ def _rgb(colour: Iterable[float]) -> str:
   return "#" + "".join(f"{round(channel):02x}" for channel in colour)
 
 
-def _heat_map(entry: exp1s_board.Exp1sEntry) -> dict:
-  """The forgetting matrix with each cell's colour (light 0, dark the largest value)."""
-  table = exp1s_board.forgetting_table(entry)
-  values = entry.forgetting()
+def _heat_map(table, values: list[list[float | None]]) -> dict:
+  """A matrix ``table`` (a label column, then a figure per column) with each cell's colour from
+  ``values`` (light 0, dark the largest value; None: a configuration not yet learned)."""
   highest = max(value for row in values for value in row if value is not None)
   rows = []
   for row, texts in zip(values, table.rows):
@@ -337,6 +337,7 @@ def _filters(board: ranking.Leaderboard) -> dict[str, list[str]]:
     entries = [entry for group in shown.groups for entry in group.entries]
     found_profiles = {entry.setting[1] for entry in entries}
     found_profiles |= {entry.setting[1] for group in shown.exp1s for entry in group.entries}
+    found_profiles |= {group.profile for group in shown.continual}
     found_modes = {entry.setting[2] for entry in entries}
     for key, found, order in (
       ("profiles", found_profiles, profiles.PROFILES),
@@ -357,6 +358,7 @@ class Earlier:
   latest_date: str | None
   task_groups: list
   exp1s: tuple
+  continual: tuple
 
 
 def _earlier(board: ranking.Leaderboard, out: pathlib.Path) -> Earlier:
@@ -368,6 +370,7 @@ def _earlier(board: ranking.Leaderboard, out: pathlib.Path) -> Earlier:
     board.latest_date,
     [(group, _task_boards(group, out, board, prefix)) for group in board.groups],
     board.exp1s,
+    board.continual,
   )
 
 
@@ -395,7 +398,13 @@ def render(board: ranking.Leaderboard, results: pathlib.Path, out: pathlib.Path)
     exp1s_about_paper=exp1s_board.about_paper(),
     exp1s_tables=exp1s_board.score_tables,
     exp1s_describe=exp1s_board.describe,
-    heat_map=_heat_map,
+    exp1s_heat=lambda entry: _heat_map(exp1s_board.forgetting_table(entry), entry.forgetting()),
+    continual=board.continual,
+    continual_explanation=continual_board.explanation(),
+    continual_table=continual_board.table,
+    continual_heat=lambda entry: _heat_map(
+      continual_board.matrix_table(entry), continual_board.matrix_values(entry)
+    ),
     record_link=lambda entry: links.record(entry, out),
     confidence=f"{ranking.CONFIDENCE:.0%}",
     resamples=f"{ranking.BOOTSTRAP_RESAMPLES:,}",

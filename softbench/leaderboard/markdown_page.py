@@ -8,6 +8,7 @@ import pathlib
 
 from softbench import agents
 from softbench.leaderboard import aggregate
+from softbench.leaderboard import continual_board
 from softbench.leaderboard import csv_table
 from softbench.leaderboard import exp1s_board
 from softbench.leaderboard import figure_table
@@ -68,9 +69,11 @@ def _intro(board: ranking.Leaderboard, views: tuple, results_link: str) -> list[
     "section of softbench's README.",
     "",
     *([_escaped(exp1s_board.explanation()), ""] if board.exp1s else []),
+    *([_escaped(continual_board.explanation()), ""] if board.continual else []),
     "Tables: "
     + ", ".join(
-      f"[{group.title}](#{group.anchor})" for group in (*views, *board.groups, *board.exp1s)
+      f"[{group.title}](#{group.anchor})"
+      for group in (*views, *board.groups, *board.exp1s, *board.continual)
     ),
     "",
   ]
@@ -252,6 +255,36 @@ def _exp1s_group(group: exp1s_board.Group, out: pathlib.Path, physics: str = "")
   return lines + [_escaped(exp1s_board.about_paper()), ""]
 
 
+def _continual_group(
+  group: continual_board.Group, out: pathlib.Path, physics: str = ""
+) -> list[str]:
+  lines = [
+    f'<a id="{physics}{"-" if physics else ""}{group.anchor}"></a>',
+    "",
+    f"## {group.title}" + (f" · physics {physics}" if physics else ""),
+    "",
+    *table_lines(continual_board.table(group)),
+  ]
+  for entry in group.entries:
+    lines += [
+      f"### {_escaped(entry.label)}",
+      "",
+      f"Record {_link(entry.path.name, links.record(entry, out))}, {entry.record['date']}.",
+      "",
+      *table_lines(continual_board.matrix_table(entry)),
+    ]
+  if group.superseded:
+    lines += [
+      "Superseded by a newer record of the same strategy: "
+      + "; ".join(
+        f"{_link(entry.path.name, links.record(entry, out))} ({_escaped(entry.label)})"
+        for entry in group.superseded
+      ),
+      "",
+    ]
+  return lines
+
+
 def render(board: ranking.Leaderboard, results: pathlib.Path, out: pathlib.Path) -> str:
   """The markdown page, with links relative to the folder ``out`` it is written to."""
   results_link = links.relative(pathlib.Path(results), out)
@@ -263,6 +296,8 @@ def render(board: ranking.Leaderboard, results: pathlib.Path, out: pathlib.Path)
     lines += _table(group, out, board)
   for group in board.exp1s:
     lines += _exp1s_group(group, out)
+  for group in board.continual:
+    lines += _continual_group(group, out)
   for older in board.earlier:
     lines += _earlier(older, out)
   return "\n".join(lines).rstrip("\n") + "\n"
@@ -284,4 +319,6 @@ def _earlier(board: ranking.Leaderboard, out: pathlib.Path) -> list[str]:
     lines += _table(group, out, board, board.physics)
   for group in board.exp1s:
     lines += _exp1s_group(group, out, board.physics)
+  for group in board.continual:
+    lines += _continual_group(group, out, board.physics)
   return lines

@@ -30,6 +30,7 @@ from softbench import metrics
 from softbench import profiles
 from softbench import records
 from softbench import suite
+from softbench.leaderboard import continual_board
 from softbench.leaderboard import exp1s_board
 from softbench.leaderboard import selection
 from softbench.records import fields as record_fields
@@ -182,6 +183,7 @@ class Leaderboard:
   physics: str = versions.LATEST  # The physics version of every record on the board.
   earlier: tuple["Leaderboard", ...] = ()  # The records of earlier physics versions, oldest first.
   verified: frozenset[str] = frozenset()  # File names of the records the zoo re-scored (verified).
+  continual: tuple[continual_board.Group, ...] = ()  # Of softbench run --protocol continual.
 
   def is_verified(self, entry: "BoardEntry") -> bool:
     """Whether ``entry``'s record is in the verification ledger as it is now
@@ -292,6 +294,7 @@ def _rank_one(loaded: list[tuple[pathlib.Path, dict]], physics: str) -> Leaderbo
     None if latest is None else latest["date"],
     exp1s_board.group(loaded),
     physics,
+    continual=continual_board.group(loaded),
   )
 
 

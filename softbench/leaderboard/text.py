@@ -4,6 +4,7 @@ robot and task, then the Exp1S sections."""
 import pathlib
 
 from softbench import records
+from softbench.leaderboard import continual_board
 from softbench.leaderboard import exp1s_board
 from softbench.leaderboard import figure_table
 from softbench.leaderboard import overview
@@ -56,6 +57,8 @@ def summary(board: ranking.Leaderboard, results: pathlib.Path, asked_for: str = 
     parts.append(
       "Exp1S: the newest record per agent and profile, in the paper's layout, mean ± std over seeds"
     )
+  if board.continual:
+    parts.append("continual: a table per stream, the newest record per strategy")
   return "; ".join(parts)
 
 
@@ -98,6 +101,17 @@ def exp1s_section(group: exp1s_board.Group) -> str:
   return "\n".join(lines)
 
 
+def continual_section(group: continual_board.Group) -> str:
+  """The title, the strategies' table, each strategy's error matrix and the superseded records."""
+  lines = [group.title, *figure_rows(continual_board.table(group))]
+  for entry in group.entries:
+    lines.append(f"  {entry.label}: {entry.path.name}")
+    lines += figure_rows(continual_board.matrix_table(entry))
+  for entry in group.superseded:
+    lines.append(f"  superseded: {entry.path.name} ({entry.label}, {entry.record['date']})")
+  return "\n".join(lines)
+
+
 def overview_section(views: tuple[overview.Overview, ...]) -> list[str]:
   """Every overview (its title and table), then what the bracketed values are."""
   if not views:
@@ -116,11 +130,13 @@ def report(board: ranking.Leaderboard, results: pathlib.Path, asked_for: str = "
     *overview_section(overview.overviews(board)),
     *(table(group) for group in board.groups),
     *(exp1s_section(group) for group in board.exp1s),
+    *(continual_section(group) for group in board.continual),
   ]
   for older in board.earlier:
     sections += [
       f"== earlier physics: {older.physics_description}, ranked apart ==",
       *(f"{table(group)}" for group in older.groups),
       *(exp1s_section(group) for group in older.exp1s),
+      *(continual_section(group) for group in older.continual),
     ]
   return "\n\n".join(sections)
