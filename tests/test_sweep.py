@@ -28,9 +28,11 @@ from softbench import storage
 from softbench import sweep
 from softbench import zoo
 from softbench.agents import learned
+from softbench.continual import streams
 from softbench.learning import exp1s as exp1s_training
 from softbench.learning import protocols
 from softbench.runners import continual
+from softbench.runners import continual_stream
 from softbench.runners import run
 from softbench.sweep import display
 from softbench.sweep import execution
@@ -116,6 +118,8 @@ def run_sweep(
     address,
     show_progress=show_progress,
     families=grid.families,
+    streams=grid.streams,
+    strategies=grid.strategies,
   )
 
 
@@ -342,8 +346,8 @@ def test_a_dry_run_lists_the_settings_without_records_and_runs_nothing(expected,
     "2 settings to run, 0 with records skipped",
     "  zero-tendon-1-circle-tiny-physics: 2 of 2 seeds",
     "  mlp-tendon-1-circle-tiny-physics: 2 of 2 seeds",
-    "to build: dataset 1, forward 2, agent 2, network 0 (0 resuming an unfinished training, run"
-    " first); found in the data home: 0",
+    "to build: dataset 1, forward 2, agent 2, network 0, stages 0 (0 resuming an unfinished "
+    "training, run first); found in the data home: 0",
   ]
   assert not ray.is_initialized() and not list(results.glob("*"))
   assert not list(storage.softbench_home().glob("*/*"))  # Nothing built.
@@ -418,6 +422,59 @@ def test_an_exp1s_record_stands_for_its_own_family_only(tmp_path):
   ]
 
 
+def test_continual_runs_in_a_sweep_write_the_record_softbench_run_writes(
+  address, tmp_path, with_babbled_dataset, monkeypatch
+):
+  tiny, pair = profiles.get("tiny"), worker_hooks.pair_stream()
+  monkeypatch.setattr(streams, "_STREAMS", {**streams._STREAMS, pair.name: pair})
+  monkeypatch.setattr(streams, "STREAMS", (*streams.STREAMS, pair.name))
+  grid = sweep.Grid((), (), (), "tiny", 1, streams=(pair.name,), strategies=("independent",))
+  run = continual_stream.ContinualSettings("independent", pair.name, "tendon", tiny, 1)
+  for stage in worker_hooks.PAIR_STAGES:
+    with_babbled_dataset(tmp_path / "run-home", stage)
+  with pytest.MonkeyPatch.context() as home:  # softbench run's record, in a home of its own.
+    home.setenv(storage.HOME_VARIABLE, str(tmp_path / "run-home"))
+    expected = records.seal(continual_stream.execute(run, show_progress=False, workers=1))
+  with ray_with_worker_hook(address, worker_hooks.register_pair_stream):
+    (path,) = run_sweep(grid, tmp_path / "results", None).written
+  assert path.name.startswith("independent-continual-pair-tiny-")
+  assert path.with_name(f"{path.stem}-matrix.png").stat().st_size > 0
+  made = records.read(path)
+  for entry in (made, expected):  # Wall times differ; everything else is the same.
+    for seed in entry["per_seed"]:
+      for stage in seed["stages"]:
+        stage["training_seconds"] = 0
+  varying = (*VARYING, "per_seed")
+  assert {key: value for key, value in made.items() if key not in varying} == {
+    key: value for key, value in json.loads(records.dumps(expected)).items() if key not in varying
+  }
+  assert made["per_seed"] == json.loads(json.dumps(expected["per_seed"]))
+  assert not continual_stream.episodes_folder(run).exists()  # The record is in.
+  work = sweep_grid.plan(grid, tmp_path / "results")
+  assert work.skipped == (path,) and not work.settings
+
+
+def test_a_continual_setting_plans_its_stages_from_the_stream_s_datasets(tmp_path):
+  grid = sweep.Grid((), (), (), "tiny", 2, streams=("degrade",), strategies=("ewc", "smpl"))
+  work = sweep_grid.plan(grid, tmp_path / "results")
+  assert [sweep_grid.setting_name(run) for run in work.settings] == [
+    "ewc-continual-degrade-tiny",
+    "smpl-continual-degrade-tiny",
+  ]
+  assert len(work.evaluations) == 4
+  stages = work.evaluations[0].agent
+  assert stages.kind == "stages" and len(stages.files) == len(streams.DEGRADE_GAINS)
+  assert [need.label for need in stages.needs] == [
+    "babbling tendon-3 200 samples",
+    *(
+      "babbling tendon-3"
+      + "".join(f" fault 3:{cable}:{gain:g}" for cable in range(4))
+      + " 200 samples"
+      for gain in streams.DEGRADE_GAINS[1:]
+    ),
+  ]
+
+
 @pytest.mark.parametrize(
   "argv,message",
   [
@@ -425,6 +482,12 @@ def test_an_exp1s_record_stands_for_its_own_family_only(tmp_path):
     (["--protocol", "exp2s"], "unknown protocol 'exp2s'"),
     (["--protocol", "exp1s", "--families", "pneumatic"], "unknown tendon family 'pneumatic'"),
     (["--protocol", "exp1s", "--robots", "tendon-1"], "at least one of its tasks"),
+    (["--streams", "grow"], "--streams goes with --protocol continual"),
+    (["--protocol", "continual", "--agents", "ewc"], "needs --streams"),
+    (["--protocol", "continual", "--streams", "grow"], "at least one of its strategies"),
+    (["--protocol", "continual", "--streams", "up", "--agents", "ewc"], "unknown stream 'up'"),
+    (["--protocol", "continual", "--streams", "grow", "--agents", "mlp"], "strategy 'mlp'"),
+    (["--protocol", "continual", "--streams", "grow", "--robots", "tendon-1"], "drop --robots"),
   ],
 )
 def test_the_cli_refuses_bad_protocol_options_in_one_line(argv, message, tmp_path, capsys):

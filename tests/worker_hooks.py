@@ -1,9 +1,10 @@
 """Changes that tests make in their own process and, as a Ray job's setup hook, in every Ray
-worker of a sweep (``test_sweep``): Exp1S shortened to two arms, or the zero agent's evaluations
-failing."""
+worker of a sweep (``test_sweep``): Exp1S shortened to two arms, the zero agent's evaluations
+failing, or a two-stage continual stream registered."""
 
 import dataclasses
 
+from softbench import robots
 from softbench.learning import protocols
 from softbench.runners import continual
 from softbench.runners import run
@@ -31,3 +32,27 @@ def break_zero_evaluations() -> None:
     return fresh_seed(settings, seed, show_progress)
 
   run.fresh_seed = broken_for_zero
+
+
+PAIR_STAGES = ("tendon-1", "tendon-2")  # The continual test stream ``pair``.
+
+
+def pair_stream():
+  """The stream ``pair``: tendon-1, then tendon-2 (of whichever family)."""
+  from softbench.continual import streams
+
+  return streams.Stream(
+    "pair",
+    "one module, then two",
+    lambda family: tuple(
+      streams.Configuration(f"{family}-{name[-1]}", robots.make(f"{family}-{name[-1]}"))
+      for name in PAIR_STAGES
+    ),
+  )
+
+
+def register_pair_stream() -> None:
+  from softbench.continual import streams
+
+  if "pair" not in streams.STREAMS:
+    streams.register(pair_stream())

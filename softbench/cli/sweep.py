@@ -10,6 +10,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
   from softbench import agents
   from softbench import robots
   from softbench import suite
+  from softbench.continual import streams
+  from softbench.records import continual as continual_records
   from softbench.records import exp1s as exp1s_records
 
   parser.add_argument(
@@ -24,14 +26,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
   parser.add_argument(
     "--protocol",
     help=f"{exp1s_records.PROTOCOL}: also SMPL's Exp1S on each of --families (then --robots, "
-    "--tasks and --agents may be left out)",
+    f"--tasks and --agents may be left out); {continual_records.PROTOCOL}: each continual "
+    f"strategy of --agents on each of --streams and --families, and nothing else",
+  )
+  parser.add_argument(
+    "--streams",
+    nargs="+",
+    metavar="STREAM",
+    help=f"with --protocol {continual_records.PROTOCOL}: of {', '.join(streams.STREAMS)}",
   )
   parser.add_argument(
     "--families",
     nargs="+",
     metavar="FAMILY",
-    help=f"with --protocol {exp1s_records.PROTOCOL}: of {', '.join(robots.TENDON_FAMILIES)} "
-    f"(default {exp1s_records.DEFAULT_FAMILY})",
+    help=f"with --protocol {exp1s_records.PROTOCOL} or {continual_records.PROTOCOL}: of "
+    f"{', '.join(robots.TENDON_FAMILIES)} (default {exp1s_records.DEFAULT_FAMILY})",
   )
   arguments.add_profile_argument(parser)
   parser.add_argument("--seeds", type=int, help=arguments.SEEDS_HELP)
@@ -61,18 +70,36 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def handle(args: argparse.Namespace) -> None:
-  from softbench import sweep
+  from softbench.records import continual as continual_records
   from softbench.runners import continual
 
   arguments.check_physics(args)
   if args.protocol is None and args.families is not None:
     raise ValueError(f"--families goes with --protocol {continual.PROTOCOL}")
+  if args.streams is not None and args.protocol != continual_records.PROTOCOL:
+    raise ValueError(f"--streams goes with --protocol {continual_records.PROTOCOL}")
+  if args.protocol == continual_records.PROTOCOL:
+    if not args.streams:
+      raise ValueError(f"--protocol {continual_records.PROTOCOL} needs --streams STREAM ...")
+    if args.robots or args.tasks:
+      raise ValueError(
+        f"--protocol {continual_records.PROTOCOL} runs strategies on streams; drop --robots "
+        f"and --tasks (--agents names the strategies)"
+      )
+    return _sweep(args, (), args.streams, args.agents)
   if args.protocol is not None:
     continual.settings(args.protocol, "smpl")  # An unknown protocol: its one line.
+  _sweep(args, args.agents)
+
+
+def _sweep(args: argparse.Namespace, agents, streams=(), strategies=()) -> None:
+  from softbench import sweep
+  from softbench.runners import continual
+
   sweep.sweep(
     args.robots,
     args.tasks,
-    args.agents,
+    agents,
     args.results,
     args.profile,
     args.seeds,
@@ -81,6 +108,8 @@ def handle(args: argparse.Namespace) -> None:
     args.data_home,
     families=(args.families or [continual.DEFAULT_FAMILY]) if args.protocol else (),
     dry_run=args.dry_run,
+    streams=streams,
+    strategies=strategies,
   )
 
 
@@ -90,7 +119,8 @@ COMMAND = Command(
   add_arguments,
   handle,
   "Runs every setting (robot, task, agent, eval mode; with --protocol exp1s, "
-  "Exp1S on each of --families) that --results has no record of for the profile, as Ray "
+  "Exp1S on each of --families; with --protocol continual, each strategy on each of "
+  "--streams) that --results has no record of for the profile, as Ray "
   "tasks: each babbling dataset, forward model, agent and Exp1S network is built once and "
   "shared, and each record is the one softbench run writes. Without --address, on a local "
   "Ray with one worker per core; docs/sweep.md for a cluster.",

@@ -89,6 +89,11 @@ def folder(named: StreamConfig) -> pathlib.Path:
   return storage.softbench_home() / FOLDER / named.key
 
 
+def stage_path(cache: pathlib.Path, stage: int) -> pathlib.Path:
+  """Where the state after stage ``stage`` is cached in ``cache`` (a ``folder``)."""
+  return cache / f"stage{stage}.pt"
+
+
 def stage_data(
   configurations: tuple[streams.Configuration, ...],
   seed: int,
@@ -204,7 +209,7 @@ def learn(
   cache = folder(config(strategy_name, stream.name, configurations, seed, profile))
   for stage in range(len(stages)):
     strategy.grow(stage)
-    path = cache / f"stage{stage}.pt"
+    path = stage_path(cache, stage)
     summary = _cached(path, strategy)
     if summary is None:
       seen = stages[: stage + 1] if strategy.continual else stages

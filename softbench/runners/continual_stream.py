@@ -172,6 +172,15 @@ def execute(
   )
   if not keep_seeds:
     episode_snapshots.discard_folder(episodes_folder(run))
+  return assemble_record(run, origin, per_seed, time.perf_counter() - started)
+
+
+def assemble_record(
+  run: ContinualSettings, origin: dict, per_seed: list[dict], wall_time_s: float
+) -> dict:
+  """The record of ``run``: provenance ``origin`` (``records.provenance``), every seed's entry
+  (``run_seed``, seed order) and ``wall_time_s``."""
+  configurations = streams.get(run.stream).configurations(run.family)
   return {
     "format": RECORD_FORMAT,
     "version": RECORD_VERSION,
@@ -186,7 +195,7 @@ def execute(
     "profile_settings": dataclasses.asdict(run.profile),
     "seeds": run.seeds,
     "per_seed": per_seed,
-    "wall_time_s": round(time.perf_counter() - started, 3),
+    "wall_time_s": round(wall_time_s, 3),
   }
 
 
@@ -235,14 +244,40 @@ def table(record: dict) -> str:
   return "\n".join(lines)
 
 
-def run_name(record: dict) -> str:
+def run_name(strategy: str, stream: str, family: str, profile_name: str) -> str:
   """``STRATEGY-continual-STREAM[-FAMILY]-PROFILE``: how its record files begin."""
-  family = [record["family"]] if record["family"] != DEFAULT_FAMILY else []
-  return "-".join([record["agent"], PROTOCOL, record["stream"], *family, record["profile"]])
+  family_part = [family] if family != DEFAULT_FAMILY else []
+  return "-".join([strategy, PROTOCOL, stream, *family_part, profile_name])
 
 
 def record_path(record: dict, results: pathlib.Path) -> pathlib.Path:
-  return results / f"{run_name(record)}-{provenance.date_stamp(record)}.json"
+  name = run_name(record["agent"], record["stream"], record["family"], record["profile"])
+  return results / f"{name}-{provenance.date_stamp(record)}.json"
+
+
+def _kept_seed_file(run: ContinualSettings, seed: int) -> tuple[pathlib.Path, str]:
+  return episodes_folder(run) / f"seed{seed}.json", f"seed {seed}"
+
+
+def kept_seed(run: ContinualSettings, seed: int) -> dict | None:
+  """The entry of ``seed`` (``run_seed``) that an interrupted sweep of ``run`` kept; None if
+  there is none (or it is damaged: reported on one line)."""
+  return episode_snapshots.load_scores(*_kept_seed_file(run, seed))
+
+
+def keep_seed(run: ContinualSettings, seed: int, entry: dict) -> None:
+  """Keeps the entry of ``seed`` until the record of ``run`` is written (``finish``)."""
+  episode_snapshots.save_scores(*_kept_seed_file(run, seed), entry)
+
+
+def stage_files(run: ContinualSettings, seed: int) -> list[pathlib.Path]:
+  """The cached state of every stage of ``seed`` (``continual.learning``), once learned."""
+  stream = streams.get(run.stream)
+  configurations = stream.configurations(run.family)
+  folder = continual_learning.folder(
+    continual_learning.config(run.strategy, run.stream, configurations, seed, run.profile)
+  )
+  return [continual_learning.stage_path(folder, stage) for stage in range(len(configurations))]
 
 
 def finish(run: ContinualSettings, record: dict, files: list[pathlib.Path]) -> None:

@@ -69,14 +69,18 @@ def sweep(
   show_progress: bool = True,
   families: Sequence[str] = (),
   dry_run: bool = False,
+  streams: Sequence[str] = (),
+  strategies: Sequence[str] = (),
 ) -> SweepResult:
   """Runs every setting of the grid that ``results`` has no record of, as Ray tasks: on the
   cluster at ``address`` (``HOST:PORT``), else on a local Ray with one worker per core (or the
   Ray this process already started); ``data_home`` replaces ``$SOFTBENCH_HOME`` for the driver
   and every worker (docs/sweep.md: what to share). ``families``: also Exp1S on each of these
-  tendon families (``softbench run --protocol exp1s --family F``); with families, the robots,
-  tasks and agents may all be empty. ``dry_run``: print what would run and build
-  (``Plan.report``) and run nothing (zoo checkpoints the grid needs are taken, as a sweep would).
+  tendon families (``softbench run --protocol exp1s --family F``); with ``streams``, each of
+  ``strategies`` on each stream and family instead (``softbench run --protocol continual``);
+  with either, the robots, tasks and agents may all be empty. ``dry_run``: print what would run
+  and build (``Plan.report``) and run nothing (zoo checkpoints the grid needs are taken, as a
+  sweep would).
 
   Raises:
     ValueError: an unknown robot, task, agent, family, profile or eval mode, seeds < 1, an
@@ -86,7 +90,15 @@ def sweep(
     KeyboardInterrupt: Ctrl-C or ``kill``; a rerun resumes.
   """
   grid = Grid(
-    tuple(robots), tuple(tasks), tuple(agents), profile, seeds, tuple(eval_modes), tuple(families)
+    tuple(robots),
+    tuple(tasks),
+    tuple(agents),
+    profile,
+    seeds,
+    tuple(eval_modes),
+    tuple(families),
+    tuple(streams),
+    tuple(strategies),
   )
   with _data_home(data_home):
     storage.check_home()

@@ -9,8 +9,8 @@ evaluations submitted early would delay the trainings that the sweep's end waits
 whose worker dies is run again (``cluster.MAX_RETRIES``). Each finished episode is kept at once
 (``episodes.snapshots``), so an interrupted sweep resumes; once a setting's seeds are all in, its
 record (``run.assemble_record``, as ``softbench run`` makes it) is saved (``saving.save``) and
-its kept episodes go (an Exp1S run: ``continual.assemble_record``, its kept seeds' scores and its
-heat map of forgetting as ``softbench run --protocol exp1s`` leaves them). A task's error is not
+its kept episodes go (an Exp1S or continual run: its record, kept seeds and heat map as
+``softbench run --protocol`` leaves them; ``kinds``). A task's error is not
 retried: the settings that need it fail, and the others go on.
 
 A record's wall time is the sweep's, from its start to that record; its provenance is the
@@ -25,14 +25,11 @@ import time
 import ray
 
 from smpl.files import first_line
-from softbench.episodes import snapshots as episode_snapshots
 from softbench.records import provenance
-from softbench.runners import continual
-from softbench.runners import run as run_module
-from softbench.runners import saving
 from softbench.sweep import cluster
 from softbench.sweep import display
 from softbench.sweep import grid
+from softbench.sweep import kinds
 from softbench.sweep import relay
 from softbench.sweep import shipping
 from softbench.sweep import tasks
@@ -140,14 +137,7 @@ def execute(
       return
     in_order = [outcomes[run][seed] for seed in range(run.seeds)]
     wall_time_s = time.perf_counter() - started
-    if isinstance(run, continual.Exp1sSettings):
-      record = continual.assemble_record(run, origin, in_order, plan.taken[run], wall_time_s)
-      files = saving.save(continual, record, results, ends_command=False)
-      continual.finish(record, files)
-    else:
-      record = run_module.assemble_record(run, origin, in_order, plan.taken[run], wall_time_s)
-      files = saving.save(run_module, record, results, ends_command=False)
-      episode_snapshots.discard(run)
+    files = kinds.of(run).save(run, origin, in_order, plan.taken[run], wall_time_s, results)
     written.append(files[0])
 
   states = relay.Relay() if show_progress else None  # The workers' bars, if shown.
@@ -182,10 +172,7 @@ def execute(
           if isinstance(task, grid.Build):
             shipping.write_missing(value)
           else:
-            if isinstance(task.run, continual.Exp1sSettings):
-              continual.keep_scores(task.run, task.seed, value)
-            else:
-              episode_snapshots.save(task.run, task.seed, value[1])
+            kinds.of(task.run).keep(task.run, task.seed, value)
             outcomes[task.run][task.seed] = value
             complete(task.run)
         running = sum(_ready(work[ref], finished) for ref in pending)

@@ -14,43 +14,42 @@ built again: its files are shipped from here.
 Exp1S (``--protocol exp1s``, one run per tendon family) fits the same graph: each seed's network
 is a build that needs the babbling datasets of the family's arms, and each seed's scores
 (``continual.run_seed``) an evaluation of it; the record is the one ``softbench run --protocol
-exp1s`` writes.
+exp1s`` writes. So does a continual strategy on a stream (``--protocol continual``): each seed's
+stages are a build that needs the datasets of the stream's configurations, and its physics
+scores an evaluation (``continual_stream.run_seed``). What differs by kind of setting is
+``kinds``'; the builds are ``builds``'.
 """
 
 import dataclasses
-import importlib
 import itertools
 import pathlib
 
-from softbench import agents
 from softbench import episodes
 from softbench import profiles
 from softbench import records
-from softbench import robots
-from softbench import storage
-from softbench import zoo
-from softbench.agents import learned
-from softbench.agents import learners
-from softbench.data import dataset as babbling_dataset
-from softbench.learning import checkpoints
-from softbench.learning import exp1s as exp1s_training
-from softbench.learning import forward_models
-from softbench.learning import inverse as inverse_training
 from softbench.records import fields as record_fields
+from softbench.records.exp1s import DEFAULT_FAMILY
 from softbench.robots import versions
 from softbench.runners import continual
-from softbench.runners import run as run_module
+from softbench.runners import continual_stream
 from softbench.runners import run_settings
+from softbench.sweep import kinds
+from softbench.sweep.builds import KINDS
+from softbench.sweep.builds import Build
+from softbench.sweep.builds import is_found
+from softbench.sweep.builds import is_under_way
+from softbench.sweep.builds import resumes
 
-KINDS = ("dataset", "forward", "agent", "network")  # What a build makes (network: Exp1S's).
-GridSetting = run_settings.RunSettings | continual.Exp1sSettings  # A task's run, or an Exp1S run.
+GridSetting = kinds.Setting  # A task's run, an Exp1S run or a continual strategy on a stream.
+ContinualSettings = continual_stream.ContinualSettings
 
 
 @dataclasses.dataclass(frozen=True)
 class Grid:
   """The settings a sweep covers; ``seeds`` None takes the profile's. ``families``: the tendon
-  families to run Exp1S on (``--protocol exp1s``); a sweep of Exp1S alone has no robots, tasks
-  or agents."""
+  families to run Exp1S on (``--protocol exp1s``), or with ``streams``, to run each of
+  ``strategies`` on each stream on (``--protocol continual``; default the tendon family); a sweep
+  of a protocol alone has no robots, tasks or agents."""
 
   robots: tuple[str, ...]
   tasks: tuple[str, ...]
@@ -59,6 +58,8 @@ class Grid:
   seeds: int | None = None
   eval_modes: tuple[str, ...] = ("physics",)
   families: tuple[str, ...] = ()
+  streams: tuple[str, ...] = ()
+  strategies: tuple[str, ...] = ()
 
   def settings(self) -> list[run_settings.RunSettings]:
     """Every task's setting once, checked (``run_settings.settings``), robot by robot, then task,
@@ -67,8 +68,8 @@ class Grid:
     Raises:
       ValueError: an empty list, or a setting ``run_settings.settings`` refuses (one line).
     """
-    if self.families and not (self.robots or self.tasks or self.agents):
-      return []  # Exp1S alone.
+    if (self.families or self.streams) and not (self.robots or self.tasks or self.agents):
+      return []  # A protocol alone.
     for name, values in (
       ("robots", self.robots),
       ("tasks", self.tasks),
@@ -85,31 +86,30 @@ class Grid:
     ]
     return list(dict.fromkeys(every))  # A name given twice is one setting.
 
-  def protocol_settings(self) -> list[continual.Exp1sSettings]:
-    """The Exp1S run of each family once, checked (``continual.settings``), its seeds resolved.
+  def protocol_settings(self) -> list[continual.Exp1sSettings | ContinualSettings]:
+    """The Exp1S run of each family once, or with ``streams`` each strategy on each stream and
+    family (stream by stream), checked (``continual.settings``, ``continual_stream.settings``),
+    their seeds resolved.
 
     Raises:
-      ValueError: an unknown family or profile, seeds < 1 (one line).
+      ValueError: an unknown family, stream, strategy or profile, a strategy that cannot run a
+        stream, streams without strategies, seeds < 1 (one line).
     """
+    if not self.streams:
+      return [
+        continual.settings(continual.PROTOCOL, "smpl", self.profile, family, self.seeds)
+        for family in dict.fromkeys(self.families)
+      ]
+    if not self.strategies:
+      raise ValueError("a sweep of streams needs at least one of its strategies (--agents)")
     return [
-      continual.settings(continual.PROTOCOL, "smpl", self.profile, family, self.seeds)
-      for family in dict.fromkeys(self.families)
+      continual_stream.settings(strategy, stream, self.profile, family, self.seeds)
+      for stream, family, strategy in itertools.product(
+        dict.fromkeys(self.streams),
+        dict.fromkeys(self.families or (DEFAULT_FAMILY,)),
+        dict.fromkeys(self.strategies),
+      )
     ]
-
-
-@dataclasses.dataclass(frozen=True)
-class Build:
-  """One thing a sweep builds once and shares: a babbling dataset, a forward model or an agent.
-
-  ``arguments`` go to its builder (``tasks.BUILDERS[kind]``); ``files`` are its cache files,
-  relative to the data home, in the order they are written (a reader's first look last);
-  ``needs`` are the builds it is made from."""
-
-  kind: str
-  label: str
-  arguments: tuple
-  files: tuple[str, ...]
-  needs: tuple["Build", ...] = ()
 
 
 @dataclasses.dataclass(frozen=True)
@@ -161,11 +161,10 @@ class Plan:
 
 
 def setting_name(run: GridSetting) -> str:
-  """``agent-robot-task-profile-eval``, as its record's file name begins; of an Exp1S run,
-  ``smpl-exp1s-[family-]profile``, as its record's."""
-  if isinstance(run, continual.Exp1sSettings):
-    return continual.run_name(run.profile.name, run.family)
-  return f"{run.agent}-{run.robot}-{run.task}-{run.profile.name}-{run.eval_mode}"
+  """How its record's file name begins: ``agent-robot-task-profile-eval`` for a task,
+  ``smpl-exp1s-[family-]profile`` for Exp1S, ``strategy-continual-stream-[family-]profile`` for a
+  continual run."""
+  return kinds.of(run).name(run)
 
 
 def existing_record(run: GridSetting, results: pathlib.Path) -> pathlib.Path | None:
@@ -178,154 +177,13 @@ def existing_record(run: GridSetting, results: pathlib.Path) -> pathlib.Path | N
   Raises:
     records.RecordError: such a file is not a valid, untouched record (one line).
   """
-  wanted = _unnamed_settings(run)
+  wanted = kinds.of(run).unnamed_settings(run)
   for path in sorted(results.glob(f"{setting_name(run)}-*.json")):
     record = records.read(path)
     same_physics = record_fields.physics_of(record) == versions.current().name
     if same_physics and {field: record.get(field) for field in wanted} == wanted:
       return path
   return None
-
-
-def _unnamed_settings(run: GridSetting) -> dict:
-  """The settings of ``run`` that its record holds but its file name does not say."""
-  if isinstance(run, continual.Exp1sSettings):
-    return {"seeds": run.seeds}
-  return {"seeds": run.seeds, "helpers": run.helpers}
-
-
-def _relative(path: pathlib.Path) -> str:
-  return path.relative_to(storage.softbench_home()).as_posix()
-
-
-def _dataset_build(robot: str, profile: profiles.Profile) -> Build:
-  config = babbling_dataset.generating_config(robot, profile.samples, inverse_training.DATA_SEED)
-  folder = babbling_dataset.dataset_folder(config)
-  return Build(
-    "dataset",
-    f"babbling {robot} {profile.samples} samples",
-    (robot, profile.samples),
-    tuple(  # The manifest last: a reader takes a dataset by its manifest.
-      _relative(folder / name) for name in (babbling_dataset.NPZ_NAME, babbling_dataset.JSON_NAME)
-    ),
-  )
-
-
-def _forward_builds(
-  robot: str, per_module: bool, seed: int, profile: profiles.Profile
-) -> tuple[Build, ...]:
-  """The forward model of each view an agent reads, each a build of its own."""
-  arm = robots.make(robot)
-  views = learners.views(arm, per_module)
-  configs = forward_models.configs(
-    arm,
-    views,
-    profile.samples,
-    inverse_training.DATA_SEED,
-    inverse_training.forward_config(seed, profile),
-    checkpoints.TRAINING_VERSION,
-  )
-  return tuple(
-    Build(
-      "forward",
-      f"forward {robot} {view.name} seed {seed}",
-      (robot, per_module, index, seed, profile),
-      (_relative(forward_models.cache_file(config)),),
-      (_dataset_build(robot, profile),),
-    )
-    for index, (view, config) in enumerate(zip(views, configs))
-  )
-
-
-def agent_build(agent: str, robot: str, seed: int, profile: profiles.Profile) -> Build | None:
-  """The build of a learned agent (None for one that does not learn): one trained on babbling
-  needs its dataset and forward models, one that learns by acting (sac) the dataset, whose
-  targets it trains on. Its files are its checkpoint, where its module says
-  (``checkpoint_path``)."""
-  entry = agents.describe(agent)
-  arm = robots.make(robot)
-  dataset = _dataset_build(robot, profile)
-  if entry.learner is not None:
-    checkpoint = learned.checkpoint_path(agent, arm, seed, profile, entry.learner.per_module)
-    needs = (dataset, *_forward_builds(robot, entry.learner.per_module, seed, profile))
-  elif entry.learned:
-    path = getattr(importlib.import_module(entry.module), "checkpoint_path", None)
-    checkpoint, needs = (None if path is None else path(arm, seed, profile)), (dataset,)
-  else:
-    return None
-  files = () if checkpoint is None else (_relative(checkpoint),)
-  return Build(
-    "agent", f"agent {agent} {robot} seed {seed}", (agent, robot, seed, profile), files, needs
-  )
-
-
-def network_build(run: continual.Exp1sSettings, seed: int) -> Build:
-  """The build of an Exp1S seed's network (``continual.build``): it needs the babbling dataset
-  of each of the family's arms."""
-  arms = dict.fromkeys(arm.name for arm, _ in exp1s_training.protocol(run.family).column_views())
-  return Build(
-    "network",
-    f"network {continual.PROTOCOL} {run.family} seed {seed}",
-    (seed, run.profile, run.family),
-    (_relative(continual.checkpoint_path(seed, run.profile, run.family)),),
-    tuple(_dataset_build(arm, run.profile) for arm in arms),
-  )
-
-
-def is_found(build: Build) -> bool:
-  """Whether the data home holds every cache file of ``build`` (one that names none: never)."""
-  home = storage.softbench_home()
-  return bool(build.files) and all((home / name).is_file() for name in build.files)
-
-
-UNFINISHED_SUFFIXES = (checkpoints.SNAPSHOT_SUFFIX, ".partial.pt")
-"""Where a cache file's unfinished training keeps its state, beside it: ``KEY.partial/`` (a
-babbling learner, a forward model; ``smpl.snapshots``) or ``KEY.partial.pt`` (sac)."""
-
-
-def resumes(build: Build) -> bool:
-  """Whether the data home holds the state of an unfinished training of ``build`` itself."""
-  home = storage.softbench_home()
-  return any(
-    (home / name).with_suffix(suffix).exists()
-    for name in build.files
-    for suffix in UNFINISHED_SUFFIXES
-  )
-
-
-def is_under_way(build: Build) -> bool:
-  """Whether ``build`` or a build it needs resumes an unfinished training."""
-  return resumes(build) or any(is_under_way(need) for need in build.needs)
-
-
-def _zoo_key(run: GridSetting) -> tuple:
-  """What the checkpoints that ``run`` takes from the zoo depend on (shared by a task's runs)."""
-  if isinstance(run, continual.Exp1sSettings):
-    return run
-  return (run.agent, run.robot, run.profile, run.seeds)
-
-
-def _take_from_zoo(run: GridSetting) -> list[str]:
-  """The zoo files taken for the checkpoints of ``run``'s seeds that the data home lacks."""
-  if isinstance(run, continual.Exp1sSettings):
-    paths = [continual.checkpoint_path(seed, run.profile, run.family) for seed in range(run.seeds)]
-    return zoo.take(paths)[0]
-  return run_module.take_from_zoo(run)[0]
-
-
-def _resumed_seed(run: GridSetting, seed: int) -> tuple[dict, episodes.Episode] | dict | None:
-  """What an interrupted run or sweep kept of ``seed``: a task's entry and episode, an Exp1S
-  seed's scores; None if nothing."""
-  if isinstance(run, continual.Exp1sSettings):
-    return continual.kept_scores(run, seed)
-  return run_module.resumed_seed(run, seed)
-
-
-def _seed_build(run: GridSetting, seed: int) -> Build | None:
-  """The build that ``seed``'s evaluation of ``run`` needs (None: none)."""
-  if isinstance(run, continual.Exp1sSettings):
-    return network_build(run, seed)
-  return agent_build(run.agent, run.robot, seed, run.profile)
 
 
 def plan(grid: Grid, results: pathlib.Path) -> Plan:
@@ -341,16 +199,17 @@ def plan(grid: Grid, results: pathlib.Path) -> Plan:
       skipped.append(existing)
       continue
     pending.append(run)
-    key = _zoo_key(run)
+    kind = kinds.of(run)
+    key = kind.zoo_key(run)
     if key not in taken_by_build:  # Before the checkpoints are looked for.
-      taken_by_build[key] = _take_from_zoo(run)
+      taken_by_build[key] = kind.take_from_zoo(run)
     taken[run] = taken_by_build[key]
     for seed in range(run.seeds):
-      outcome = _resumed_seed(run, seed)
+      outcome = kind.resumed_seed(run, seed)
       if outcome is not None:
         resumed[run, seed] = outcome
       else:
-        evaluations.append(Evaluation(run, seed, _seed_build(run, seed)))
+        evaluations.append(Evaluation(run, seed, kind.seed_build(run, seed)))
   builds, found = {}, set()
 
   def add(build: Build) -> None:

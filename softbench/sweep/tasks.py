@@ -4,7 +4,8 @@ Each task first sets its process up as ``softbench run``'s seed workers are (one
 ``smpl.training.CPU_THREADS``; one-line warnings; its bars relayed to the sweep's display) and
 writes the cache files of the builds it is given that its data home lacks (``shipping``). A build
 then finds or makes its cached files and returns them; an evaluation returns its seed's record
-entry and episode (``run.fresh_seed``), or an Exp1S seed's scores (``continual.run_seed``).
+entry and episode (``run.fresh_seed``), an Exp1S seed's scores (``continual.run_seed``) or a
+continual seed's stages and scores (``continual_stream.run_seed``): as ``kinds`` says.
 """
 
 from collections.abc import Iterator
@@ -20,11 +21,12 @@ from softbench import progress
 from softbench import robots
 from softbench import terminal
 from softbench.agents import learners
+from softbench.continual import learning as continual_learning
+from softbench.continual import streams
 from softbench.episodes import snapshots as episode_snapshots
 from softbench.learning import inverse as inverse_training
 from softbench.runners import continual
-from softbench.runners import run as run_module
-from softbench.runners import run_settings
+from softbench.sweep import kinds
 from softbench.sweep import relay
 from softbench.sweep import shipping
 
@@ -69,11 +71,20 @@ def _train_network(seed: int, profile, family: str) -> None:
   continual.build(seed, profile, False, family)
 
 
+def _learn_stages(run, seed: int) -> None:
+  """Every stage of a continual strategy's seed on its stream (``continual.learning``)."""
+  for _ in continual_learning.learn(
+    run.strategy, streams.get(run.stream), run.family, seed, run.profile
+  ):
+    pass
+
+
 BUILDERS = {
   "dataset": _collect,
   "forward": _train_forward_model,
   "agent": _build_agent,
   "network": _train_network,
+  "stages": _learn_stages,
 }
 
 
@@ -93,7 +104,7 @@ def build(
 
 
 def evaluate(
-  run: run_settings.RunSettings | continual.Exp1sSettings,
+  run: kinds.Setting,
   seed: int,
   *needed: shipping.Files,
   states: relay.Relay | None = None,
@@ -102,9 +113,7 @@ def evaluate(
   an Exp1S run, the seed's scores, by the network of ``needed``. ``states``: as ``build``'s."""
   with _relayed(states):
     shipping.write_missing(*needed)
-    if isinstance(run, continual.Exp1sSettings):
-      return continual.run_seed(seed, run.profile, run.family)
-    return run_module.fresh_seed(run, seed)
+    return kinds.of(run).evaluate(run, seed)
 
 
 def node_facts() -> tuple[str, str]:
