@@ -358,3 +358,13 @@ def test_stack_speed_measures_each_stack_in_a_fresh_process(monkeypatch, capsys)
   )
   assert all(float(value.replace(",", "")) > 0 for value in row)
   assert f"MuJoCo {versions.engine_version()}" in out
+
+
+def test_ewc_lambda_scores_both_configurations_for_every_lambda(monkeypatch, capsys):
+  printed = run_script(
+    "ewc_lambda", ["--profile", "tiny", "--lambdas", "0", "1e7"], monkeypatch, capsys
+  )
+  rows = [json.loads(line) for line in printed.splitlines() if line.startswith("{")]
+  assert [row["lambda"] for row in rows] == [0.0, 1e7]
+  for row in rows:
+    assert row["mean"] == pytest.approx((row["first"] + row["second"]) / 2)
