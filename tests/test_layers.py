@@ -156,6 +156,7 @@ TOP_LEVEL_MODULES = {
   "metrics": "tracking scores, read by episodes, runners, records and the leaderboard alike",
   "plots": "matplotlib figures of episodes and results, for runners and the leaderboard",
   "profiles": "data and epoch budgets, read by every layer",
+  "registries": "the naming rule of every registry: agents, tasks, strategies, streams",
   "progress": "progress bars of long work, in every layer",
   "storage": "the data home, atomic writes and hashes, under every layer",
   "terminal": "tables, JSON and one-line warnings on the terminal, for every command",
@@ -175,6 +176,7 @@ def test_the_top_level_holds_packages_and_a_few_modules_that_say_why():
     "softbench.records, softbench.records.exp1s, softbench.records.provenance",
     "softbench.leaderboard, softbench.leaderboard.html_page, softbench.leaderboard.overview",
     "softbench.cli.listings, softbench.terminal",
+    "softbench.continual.strategies, softbench.continual.streams, softbench.records.continual",
   ],
 )
 def test_the_registries_and_the_records_import_without_torch(modules):

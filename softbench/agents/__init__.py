@@ -20,6 +20,7 @@ from importlib import metadata
 from typing import Callable
 
 from softbench import profiles
+from softbench import registries
 from softbench import robots
 from softbench import storage
 from softbench.agents.base import Agent
@@ -105,10 +106,7 @@ def register(name: str, entry: AgentEntry) -> None:
     ValueError: the name is taken or malformed, or the entry is inconsistent (one line).
   """
   global AGENTS
-  if not isinstance(name, str) or not name or name != name.strip().lower() or " " in name:
-    raise ValueError(f"agent names are lowercase words without spaces, got {name!r}")
-  if name in _AGENTS:
-    raise ValueError(f"agent {name!r} is registered already")
+  registries.check_new_name("agent", name, _AGENTS)
   if (entry.module is None) == (entry.learner is None):
     raise ValueError(f"agent {name!r}: give either the module that builds it or its learner")
   _AGENTS[name] = entry

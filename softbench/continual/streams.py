@@ -25,6 +25,7 @@ code.
 from collections.abc import Callable
 import dataclasses
 
+from softbench import registries
 from softbench import robots
 from softbench import suite
 from softbench.records.exp1s import DEFAULT_FAMILY
@@ -138,10 +139,7 @@ def register(stream: Stream) -> None:
   """
   global STREAMS
   name = stream.name
-  if not isinstance(name, str) or not name or name != name.strip().lower() or " " in name:
-    raise ValueError(f"stream names are lowercase words without spaces, got {name!r}")
-  if name in _STREAMS:
-    raise ValueError(f"stream {name!r} is registered already")
+  registries.check_new_name("stream", name, _STREAMS)
   suite.describe(stream.task)
   _STREAMS[name] = stream
   STREAMS = tuple(_STREAMS)

@@ -225,13 +225,34 @@ def table_lines(table: figure_table.Table) -> list[str]:
   ]
 
 
-def _exp1s_group(group: exp1s_board.Group, out: pathlib.Path, physics: str = "") -> list[str]:
-  lines = [
+def _group_heading(group, physics: str) -> list[str]:
+  """The anchor and heading of an Exp1S or continual group (of an earlier ``physics``, if
+  given)."""
+  return [
     f'<a id="{physics}{"-" if physics else ""}{group.anchor}"></a>',
     "",
     f"## {group.title}" + (f" · physics {physics}" if physics else ""),
     "",
   ]
+
+
+def _superseded(group, out: pathlib.Path, setting: str) -> list[str]:
+  """The records a group's shown ones superseded, linked (none: no lines)."""
+  if not group.superseded:
+    return []
+  return [
+    f"Superseded by a newer record of the same {setting}: "
+    + "; ".join(
+      f"{_link(entry.path.name, links.record(entry, out))} "
+      f"({_escaped(entry.label)}, {entry.record['date']})"
+      for entry in group.superseded
+    ),
+    "",
+  ]
+
+
+def _exp1s_group(group: exp1s_board.Group, out: pathlib.Path, physics: str = "") -> list[str]:
+  lines = _group_heading(group, physics)
   for entry in group.entries:
     lines += [
       f"### {_escaped(entry.label)}",
@@ -242,29 +263,14 @@ def _exp1s_group(group: exp1s_board.Group, out: pathlib.Path, physics: str = "")
     ]
     for table in exp1s_board.tables(entry):
       lines += table_lines(table)
-  if group.superseded:
-    lines += [
-      "Superseded by a newer record of the same agent and profile: "
-      + "; ".join(
-        f"{_link(entry.path.name, links.record(entry, out))} "
-        f"({_escaped(entry.label)}, {entry.record['date']})"
-        for entry in group.superseded
-      ),
-      "",
-    ]
+  lines += _superseded(group, out, "agent and profile")
   return lines + [_escaped(exp1s_board.about_paper()), ""]
 
 
 def _continual_group(
   group: continual_board.Group, out: pathlib.Path, physics: str = ""
 ) -> list[str]:
-  lines = [
-    f'<a id="{physics}{"-" if physics else ""}{group.anchor}"></a>',
-    "",
-    f"## {group.title}" + (f" · physics {physics}" if physics else ""),
-    "",
-    *table_lines(continual_board.table(group)),
-  ]
+  lines = [*_group_heading(group, physics), *table_lines(continual_board.table(group))]
   for entry in group.entries:
     lines += [
       f"### {_escaped(entry.label)}",
@@ -273,16 +279,7 @@ def _continual_group(
       "",
       *table_lines(continual_board.matrix_table(entry)),
     ]
-  if group.superseded:
-    lines += [
-      "Superseded by a newer record of the same strategy: "
-      + "; ".join(
-        f"{_link(entry.path.name, links.record(entry, out))} ({_escaped(entry.label)})"
-        for entry in group.superseded
-      ),
-      "",
-    ]
-  return lines
+  return lines + _superseded(group, out, "strategy")
 
 
 def render(board: ranking.Leaderboard, results: pathlib.Path, out: pathlib.Path) -> str:

@@ -90,15 +90,22 @@ def settings(
       f"--protocol {PROTOCOL} trains SMPL's columns in sequence; it takes --agent smpl, "
       f"got {agent!r}"
     )
-  if task_options or eval_mode != "physics":
-    raise ValueError(
-      f"--protocol {PROTOCOL} fixes its robots, tasks and loops; drop "
-      f"{', '.join(task_options) or '--eval'}"
-    )
+  check_fixed_options(PROTOCOL, "its robots, tasks and loops", task_options, eval_mode)
   chosen = profiles.get(profile)
   family = family or DEFAULT_FAMILY
   exp1s_training.protocol(family)
   return Exp1sSettings(chosen, family, seed_count(chosen, seeds))
+
+
+def check_fixed_options(
+  protocol_name: str, fixed: str, task_options: Sequence[str], eval_mode: str
+) -> None:
+  """Refuses a task run's options (``task_options``: the flags given) and any eval mode but
+  physics for a protocol that fixes ``fixed`` (one line)."""
+  if task_options or eval_mode != "physics":
+    raise ValueError(
+      f"--protocol {protocol_name} fixes {fixed}; drop {', '.join(task_options) or '--eval'}"
+    )
 
 
 def seed_count(profile: profiles.Profile, seeds: int | None) -> int:

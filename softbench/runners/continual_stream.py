@@ -74,11 +74,9 @@ def settings(
     )
   chosen_stream = streams.get(stream)
   strategies.describe(strategy)
-  if task_options or eval_mode != "physics":
-    raise ValueError(
-      f"--protocol {PROTOCOL} fixes its robots, task and loop (the stream's); drop "
-      f"{', '.join(task_options) or '--eval'}"
-    )
+  exp1s_runner.check_fixed_options(
+    PROTOCOL, "its robots, task and loop (the stream's)", task_options, eval_mode
+  )
   chosen = profiles.get(profile)
   family = family or DEFAULT_FAMILY
   configurations = chosen_stream.configurations(family)

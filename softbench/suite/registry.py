@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 from typing import Any
 from typing import Callable
 
+from softbench import registries
 from softbench import robots
 
 if TYPE_CHECKING:
@@ -55,10 +56,7 @@ def register(name: str, entry: TaskEntry) -> None:
   Raises:
     ValueError: the name is taken or malformed, or the paper robot is unknown (one line).
   """
-  if not isinstance(name, str) or not name or name != name.strip().lower() or " " in name:
-    raise ValueError(f"task names are lowercase words without spaces, got {name!r}")
-  if name in _TASKS:
-    raise ValueError(f"task {name!r} is registered already")
+  registries.check_new_name("task", name, _TASKS)
   if not isinstance(entry, TaskEntry):
     raise ValueError(f"task {name!r}: a TaskEntry is needed, got {type(entry).__name__}")
   robots.make(entry.paper_robot)

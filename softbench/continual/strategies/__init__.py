@@ -18,6 +18,8 @@ what a strategy is.
 import collections
 import importlib
 
+from softbench import registries
+
 StrategyEntry = collections.namedtuple("StrategyEntry", ["module", "description"])
 """A strategy: the module whose ``STRATEGY`` class it is, and a one-line description."""
 
@@ -53,10 +55,7 @@ def register(name: str, entry: StrategyEntry) -> None:
     ValueError: the name is taken or malformed (one line).
   """
   global STRATEGIES
-  if not isinstance(name, str) or not name or name != name.strip().lower() or " " in name:
-    raise ValueError(f"strategy names are lowercase words without spaces, got {name!r}")
-  if name in _STRATEGIES:
-    raise ValueError(f"strategy {name!r} is registered already")
+  registries.check_new_name("strategy", name, _STRATEGIES)
   _STRATEGIES[name] = entry
   STRATEGIES = tuple(_STRATEGIES)
 

@@ -1,22 +1,11 @@
 """``finetune``: one shared network (``softbench.continual.networks``) trained on each stage's
 data in turn, nothing done to keep what earlier stages taught it: the lower bound of remembering."""
 
-from softbench.continual import networks
 from softbench.continual.strategies import base
+from softbench.continual.strategies import shared
 
 
-class Finetune(base.Strategy):
-  def __init__(self, setting: base.Setting) -> None:
-    super().__init__(setting)
-    self.module.network = self.new_seeded(
-      0, lambda: networks.shared_network(setting.pose_size, list(setting.action_sizes))
-    )
-
-  def controller(self, configuration: int):
-    return networks.ConfiguredModel(
-      self.module.network, configuration, self.setting.pose_size, list(self.setting.action_sizes)
-    ).eval()
-
+class Finetune(shared.SharedNetwork):
   def learn(self, stage, stages, on_epoch_end) -> base.StageTraining:
     model = self.controller(stage)
     result = base.fit_configuration(

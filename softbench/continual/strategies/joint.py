@@ -9,23 +9,12 @@ import torch
 
 from smpl import training
 from smpl import windows as smpl_windows
-from softbench.continual import networks
 from softbench.continual.strategies import base
+from softbench.continual.strategies import shared
 
 
-class Joint(base.Strategy):
+class Joint(shared.SharedNetwork):
   continual = False
-
-  def __init__(self, setting: base.Setting) -> None:
-    super().__init__(setting)
-    self.module.network = self.new_seeded(
-      0, lambda: networks.shared_network(setting.pose_size, list(setting.action_sizes))
-    )
-
-  def controller(self, configuration: int):
-    return networks.ConfiguredModel(
-      self.module.network, configuration, self.setting.pose_size, list(self.setting.action_sizes)
-    ).eval()
 
   def learn(self, stage, stages, on_epoch_end) -> base.StageTraining:
     if stage:
