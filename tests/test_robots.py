@@ -20,6 +20,7 @@ from softbench.robots import REGISTERED_ROBOTS
 from softbench.robots import TENDON_FAMILIES
 from softbench.robots import make
 from softbench.robots import measure
+from softbench.robots import payload as payload_model
 from softbench.robots import pneumatic
 from softbench.robots import tendon_family
 from softbench.robots import versions
@@ -317,6 +318,17 @@ def test_a_one_module_local_arm_is_the_one_module_arm():
     )
 
 
+@pytest.mark.parametrize("robot_name", REGISTERED_ROBOTS)
+def test_a_payload_adds_its_mass_at_the_tip_and_none_changes_nothing(robot_name):
+  robot, grams = make(robot_name), 7.0
+  assert make(robot_name, payload=0.0).to_xml() == robot.to_xml()
+  loaded = make(robot_name, payload=grams / 1000)
+  assert loaded.mass() - robot.mass() == pytest.approx(grams / 1000)
+  model = loaded.compile()
+  tip = model.site(f"module{robot.num_modules}_tip")
+  assert model.body(payload_model.BODY).parentid[0] == tip.bodyid[0]
+
+
 # 6. Bad input.
 
 
@@ -346,6 +358,10 @@ def test_a_one_module_local_arm_is_the_one_module_arm():
     ("tendon-" + "9" * 5000, {}),
     ("tendon-1", {"num_modules": 0}),  # The name gives the count.
     ("tendon-1", {"num_modules": 2}),
+    ("tendon-3", {"payload": -0.005}),
+    ("tendon-3", {"payload": float("nan")}),
+    ("pneumatic-433", {"payload": 2.0}),  # Over robots.payload.MAX_PAYLOAD.
+    ("tendon-local-2", {"payload": True}),
   ],
   ids=lambda value: repr(value)[:40],
 )
