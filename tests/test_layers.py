@@ -134,6 +134,7 @@ BOUNDARIES = (
   ("records", {"runners", "sweep", "learning", "agents", "leaderboard", "cli"}, "records are read"),
   ("learning", {"agents", "runners", "sweep", "cli"}, "training knows no agent or runner"),
   ("agents", {"runners", "sweep", "cli"}, "an agent acts; runners run it"),
+  ("continual", {"runners", "sweep", "cli", "leaderboard"}, "strategies learn; runners score"),
   ("runners", {"sweep", "cli"}, "the sweep and the command line call the runners"),
 )
 
