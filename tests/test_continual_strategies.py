@@ -172,6 +172,21 @@ def test_bad_continual_input_is_one_line_and_exit_2(registries, flags, message, 
   assert len(err) == 1 and message in err[0], err
 
 
+def test_softbench_streams_lists_every_stream_and_strategy(registries, capsys):
+  streams.register(PAIR)
+  assert cli.main(["streams", "--json", "--family", "tendon-local"]) == 0
+  listed = json.loads(capsys.readouterr().out)
+  assert [entry["name"] for entry in listed["streams"]] == list(streams.STREAMS)
+  assert [entry["name"] for entry in listed["strategies"]] == list(strategies.STRATEGIES)
+  pair = next(entry for entry in listed["streams"] if entry["name"] == "pair")
+  assert [c["robot"] for c in pair["configurations"]] == ["tendon-local-1", "tendon-local-2"]
+  assert cli.main(["streams"]) == 0
+  printed = capsys.readouterr().out
+  assert all(name in printed for name in (*streams.STREAMS, *strategies.STRATEGIES))
+  assert cli.main(["streams", "--family", "rope"]) == 2
+  assert "unknown tendon family 'rope'" in capsys.readouterr().err
+
+
 def test_stream_without_its_protocol_is_one_line(capsys):
   assert cli.main(["run", "--task", "spiral", "--agent", "zero", "--stream", "grow"]) == 2
   assert "--stream goes with --protocol continual" in capsys.readouterr().err

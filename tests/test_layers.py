@@ -194,6 +194,7 @@ TORCHLESS_COMMANDS = (
   ["robots", "tendon-3"],
   ["tasks", "--json"],
   ["agents"],
+  ["streams", "--json"],
   ["leaderboard", "--grid", "agents"],
   ["models"],
   ["run", "--help"],
@@ -212,7 +213,7 @@ def test_the_help_and_the_listings_of_the_command_line_load_no_torch():
   result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
   codes_and_torch = result.stderr.strip().splitlines()[-1]
   # --help, --version and a command missing its subcommand end as argparse ends them: 0, 0, 2.
-  assert codes_and_torch == "[0, 0, 0, 0, 0, 0, 2, 0, 0, 0] False"
+  assert codes_and_torch == "[0, 0, 0, 0, 0, 0, 0, 2, 0, 0, 0] False"
   assert "usage: softbench" in result.stdout and "tendon-3" in result.stdout
 
 

@@ -25,6 +25,7 @@ from softbench.cli import render
 from softbench.cli import retrain
 from softbench.cli import robots
 from softbench.cli import run
+from softbench.cli import streams
 from softbench.cli import sweep
 from softbench.cli import tasks
 from softbench.cli import tune
@@ -41,6 +42,7 @@ _COMMANDS = {
     tasks,
     collect,
     agents,
+    streams,
     tune,
     run,
     sweep,

@@ -1,6 +1,6 @@
-"""What ``softbench robots``, ``tasks`` and ``agents`` list: a table for people (``*_table``) and a
-JSON document for scripts (``*_document``, their ``--json``), from the registries alone (without
-torch)."""
+"""What ``softbench robots``, ``tasks``, ``agents`` and ``streams`` list: a table for people
+(``*_table``) and a JSON document for scripts (``*_document``, their ``--json``), from the
+registries alone (without torch)."""
 
 from rich.console import Group
 from rich.console import RenderableType
@@ -10,6 +10,8 @@ from softbench import robots
 from softbench import suite
 from softbench import terminal
 from softbench.agents import hyperparameters
+from softbench.continual import strategies
+from softbench.continual import streams
 from softbench.robots import export as model_export
 
 _ROBOT_COLUMNS = ("robot", "modules", "action dim", "length mm", "mass g")
@@ -132,3 +134,39 @@ def agents_table(verbose: bool = False) -> RenderableType:
         for robot, values in tuned.get(name, {}).items()
       ]
   return terminal.table(("agent", "learns", "description"), rows)
+
+
+def streams_document(family: str = streams.DEFAULT_FAMILY) -> dict:
+  """Every continual stream (its configurations on ``family``) and every continual strategy."""
+  return {
+    "streams": [
+      {
+        "name": name,
+        "description": streams.get(name).description,
+        "task": streams.get(name).task,
+        "configurations": [c.describe() for c in streams.get(name).configurations(family)],
+      }
+      for name in streams.STREAMS
+    ],
+    "strategies": [
+      {"name": name, "description": strategies.describe(name).description}
+      for name in strategies.STRATEGIES
+    ],
+  }
+
+
+def streams_table(family: str = streams.DEFAULT_FAMILY) -> RenderableType:
+  """The streams with their configurations on ``family``, then the strategies."""
+  listed = streams_document(family)
+  stream_rows = [
+    [entry["name"], ", ".join(c["label"] for c in entry["configurations"]), entry["description"]]
+    for entry in listed["streams"]
+  ]
+  strategy_rows = [[entry["name"], entry["description"]] for entry in listed["strategies"]]
+  return Group(
+    terminal.table(("stream", f"configurations ({family})", "what changes"), stream_rows),
+    "",
+    terminal.table(("strategy", "description"), strategy_rows),
+    "",
+    "softbench run --protocol continual --stream STREAM --agent STRATEGY; docs/continual.md",
+  )
