@@ -6,6 +6,7 @@ would leave their folder, and environment variables that name the wrong thing.""
 import contextlib
 import os
 import pathlib
+import re
 import select
 import signal
 import subprocess
@@ -25,6 +26,7 @@ from softbench import terminal
 from softbench import tuning
 from softbench import zoo
 from softbench.episodes import snapshots as episode_snapshots
+from softbench.records import provenance
 from softbench.runners import continual
 from softbench.runners import retrain
 from softbench.runners import run
@@ -343,3 +345,23 @@ def test_a_local_ray_ends_with_its_driver_killed_outright():
   finally:
     driver.kill()  # A no-op once it has ended.
     process_tree.kill(left)
+
+
+def test_a_record_s_commit_is_dirty_for_changed_code_not_for_new_records(tmp_path):
+  git = lambda *argv: subprocess.run(["git", *argv], cwd=tmp_path, check=True, capture_output=True)
+  (tmp_path / "softbench").mkdir()
+  (tmp_path / "softbench" / "module.py").write_text("X = 1\n")
+  git("init", "-q")
+  git("add", ".")
+  git("-c", "user.name=t", "-c", "user.email=t@t", "commit", "-qm", "code")
+  clean = provenance.git_commit(tmp_path)
+  assert re.fullmatch("[0-9a-f]{40}", clean)
+  (tmp_path / "leaderboard" / "results").mkdir(parents=True)
+  (tmp_path / "leaderboard" / "results" / "record.json").write_text("{}")
+  assert provenance.git_commit(tmp_path) == clean  # A long run's own records.
+  (tmp_path / "smpl").mkdir()
+  (tmp_path / "smpl" / "new.py").write_text("")
+  assert provenance.git_commit(tmp_path) == f"{clean}-dirty"  # Untracked code.
+  (tmp_path / "smpl" / "new.py").unlink()
+  (tmp_path / "softbench" / "module.py").write_text("X = 2\n")
+  assert provenance.git_commit(tmp_path) == f"{clean}-dirty"

@@ -1,6 +1,7 @@
-"""Provenance of a record: softbench's version, the git commit (``-dirty`` with local changes), the
-date, the physics version (``softbench.robots.versions``) and the machine (platform, CPU model and
-widest vector extension, cores, Python, MuJoCo, torch and the device it computed on)."""
+"""Provenance of a record: softbench's version, the git commit (``-dirty`` with local changes to
+the code: ``SOURCE_PATHS``; new records in a results folder are not), the date, the physics
+version (``softbench.robots.versions``) and the machine (platform, CPU model and widest vector
+extension, cores, Python, MuJoCo, torch and the device it computed on)."""
 
 import datetime
 from importlib import metadata
@@ -12,22 +13,24 @@ import subprocess
 import softbench
 from softbench.robots import versions
 
+SOURCE_PATHS = ("softbench", "smpl", "pyproject.toml", "constraints.txt", "constraints-v0.txt")
+"""What makes a checkout's code, relative to its root: a change there (tracked or not) makes the
+commit ``-dirty``. Records written into ``leaderboard/results`` of a clean checkout, as a
+long run's records are one by one, were marking every later record dirty."""
 
-def _git_commit() -> str | None:
+
+def git_commit(root: pathlib.Path = pathlib.Path(__file__).parents[2]) -> str | None:
+  """The commit of the checkout at ``root``, ``-dirty`` if its code changed; None outside git."""
   try:
     commit = subprocess.run(
-      ["git", "rev-parse", "HEAD"],
-      capture_output=True,
-      text=True,
-      check=True,
-      cwd=pathlib.Path(__file__).parent,
+      ["git", "rev-parse", "HEAD"], capture_output=True, text=True, check=True, cwd=root
     ).stdout.strip()
     dirty = subprocess.run(
-      ["git", "status", "--porcelain"],
+      ["git", "status", "--porcelain", "--", *SOURCE_PATHS],
       capture_output=True,
       text=True,
       check=True,
-      cwd=pathlib.Path(__file__).parent,
+      cwd=root,
     ).stdout.strip()
   except (OSError, subprocess.CalledProcessError):
     return None
@@ -67,7 +70,7 @@ def provenance(device: str) -> dict:
   (the code may change while it runs)."""
   return {
     "softbench_version": softbench.__version__,
-    "git_commit": _git_commit(),
+    "git_commit": git_commit(),
     "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
     "physics": versions.current().name,
     "machine": _machine(device),
