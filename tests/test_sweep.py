@@ -34,6 +34,7 @@ from softbench.learning import protocols
 from softbench.runners import continual
 from softbench.runners import continual_stream
 from softbench.runners import run
+from softbench.sweep import builds as sweep_builds
 from softbench.sweep import display
 from softbench.sweep import execution
 from softbench.sweep import grid as sweep_grid
@@ -370,7 +371,7 @@ def test_trainings_under_way_are_submitted_before_new_ones(data_home, tmp_path):
     return [build.label for build in plan.builds if build.kind == "agent"]
 
   assert order() == ["agent mlp tendon-1 seed 0", "agent mlp tendon-1 seed 1"]
-  (seed_1,) = sweep_grid.agent_build("mlp", "tendon-1", 1, profiles.get("tiny")).files
+  (seed_1,) = sweep_builds.agent_build("mlp", "tendon-1", 1, profiles.get("tiny")).files
   (data_home / seed_1).with_suffix(".partial").mkdir(parents=True)  # Its snapshots' folder.
   assert order() == ["agent mlp tendon-1 seed 1", "agent mlp tendon-1 seed 0"]
   report = sweep_grid.plan(grid, tmp_path / "results").report()

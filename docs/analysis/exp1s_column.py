@@ -111,7 +111,7 @@ def main() -> None:
         arm, name, seed=args.seed, **suite.length_options(name, profile.episode_length)
       )
       episode = evaluation.run_episode(env, agent, name)
-      score = continual._end_effector_scores(episode, arm.length)
+      score = continual.end_effector_scores(episode, arm.length)
       print(
         f"{label}: {arm.name} {name}, closed loop in physics: end effector "
         f"{score['position_mm']:.2f} mm, {score['orientation_deg']:.2f} deg, "
