@@ -6,8 +6,9 @@ ranking gives it (``ranking.Estimate``): the average final error (mm, and % of l
 (mm), forward transfer against the table's ``independent`` record (% of its error removed, on the
 seeds both hold; ``softbench.continual.metrics``), the same on the training curves, the
 parameters after the last stage and the training time over all stages. Rows are ordered by average
-final error. Every page (``text``, ``markdown_page``, ``html_page``) renders the same ``Table``
-objects.
+final error. A second table gives each configuration's error right after its own stage, per
+strategy, and the forward transfer on it. Every page (``text``, ``markdown_page``,
+``html_page``) renders the same ``Table`` objects.
 """
 
 import dataclasses
@@ -110,8 +111,9 @@ def _transfer(
   return ranking.Estimate.of([value * PERCENT for value in values]) if values else None
 
 
-def table(group: Group) -> Table:
-  """The strategies of ``group`` side by side (module docstring)."""
+def table(group: Group, with_times: bool = True) -> Table:
+  """The strategies of ``group`` side by side (module docstring); without the training times
+  unless ``with_times`` (they change from machine to machine; the docs' tables leave them out)."""
   rows = []
   for entry in group.entries:
     last = [seed["stages"] for seed in entry.record["per_seed"]]
@@ -128,25 +130,73 @@ def table(group: Group) -> Table:
         f"{np.mean([sum(s['training_seconds'] for s in stages) for stages in last]):.0f}",
       )
     )
+  header = (
+    "strategy",
+    "seeds",
+    "final error (mm)",
+    "final error (%)",
+    "forgetting (mm)",
+    "forward transfer (%)",
+    "curve transfer (%)",
+    "parameters",
+    "training (s)",
+  )
+  kept = len(header) if with_times else len(header) - 1
   return Table(
-    f"{group.stream}: {', '.join(group.labels)}; end-effector error on "
+    f"{group.stream} ({group.family}, {group.profile} profile): {', '.join(group.labels)}; "
+    f"end-effector error on "
     f"{group.entries[0].record['task']} in physics after the last stage, mean ± std over seeds "
     f"[95% bootstrap CI]; forward transfer against {REFERENCE} (share of its error removed on "
     f"each newly learned configuration; on training curves: 1 - loss AUC ratio)",
-    (
-      "strategy",
-      "seeds",
-      "final error (mm)",
-      "final error (%)",
-      "forgetting (mm)",
-      "forward transfer (%)",
-      "curve transfer (%)",
-      "parameters",
-      "training (s)",
-    ),
+    header[:kept],
+    tuple(row[:kept] for row in rows),
+    label_columns=1,
+  )
+
+
+def diagonal_table(group: Group) -> Table:
+  """Each configuration's error right after its own stage (the matrix's diagonal, mm, mean ± std
+  over seeds) per strategy, then each strategy's forward transfer on it against ``REFERENCE``
+  (%, over the seeds both hold; from the second configuration on)."""
+  reference = group.reference
+  others = [entry for entry in group.entries if entry is not reference]
+  rows = []
+  for index, label in enumerate(group.labels):
+    cells = [label]
+    for entry in group.entries:
+      values = [matrix[index, index] for matrix in continual_metrics.matrices(entry.record)]
+      cells.append(ranking.mean_and_std(ranking.Estimate.of(values)))
+    for entry in others if reference is not None else ():
+      transfers = [
+        continual_metrics.transfer_per_stage(mine, theirs)[index - 1]
+        for mine, theirs in _paired_matrices(entry, reference)
+      ]
+      shown = index and transfers
+      cells.append(
+        ranking.mean_and_std(ranking.Estimate.of([v * PERCENT for v in transfers]))
+        if shown
+        else "-"
+      )
+    rows.append(tuple(cells))
+  transfer_columns = [f"transfer, {entry.label} (%)" for entry in others] if reference else []
+  return Table(
+    f"{group.stream} ({group.family}, {group.profile} profile): each configuration's end-effector "
+    f"error (mm) on {group.entries[0].record['task']} right after its own stage, mean ± std over "
+    f"seeds; forward transfer against {REFERENCE}: the share of its error removed",
+    ("configuration", *(entry.label for entry in group.entries), *transfer_columns),
     tuple(rows),
     label_columns=1,
   )
+
+
+def _paired_matrices(entry: ContinualEntry, reference: ContinualEntry):
+  """(entry's, reference's) error matrices of every seed both records hold."""
+  theirs = {seed["seed"]: seed for seed in reference.record["per_seed"]}
+  return [
+    (continual_metrics.error_matrix(seed), continual_metrics.error_matrix(theirs[seed["seed"]]))
+    for seed in entry.record["per_seed"]
+    if seed["seed"] in theirs
+  ]
 
 
 def matrix_table(entry: ContinualEntry) -> Table:

@@ -12,6 +12,7 @@ from typing import Callable
 from softbench import agents
 from softbench import metrics
 from softbench import suite
+from softbench.leaderboard import continual_board
 from softbench.leaderboard import exp1s_board
 from softbench.leaderboard import overview
 from softbench.leaderboard import paper_tables
@@ -354,6 +355,25 @@ TENDON_3_PAPER = TableSetting("tendon-3", "paper")
 LOCAL_3_PAPER = TableSetting("tendon-local-3", "paper")
 PNEUMATIC_PAPER = TableSetting("pneumatic-433", "paper")
 
+
+def continual_table(
+  stream: str, family: str, profile: str, diagonal: bool = False
+) -> Callable[[ranking.Leaderboard], Table]:
+  """Every strategy's record of ``stream`` on ``family`` at ``profile`` (``continual_board``):
+  their figures, training times left out, or with ``diagonal`` each configuration's error after
+  its own stage and the forward transfer on it."""
+
+  def table(board: ranking.Leaderboard) -> Table:
+    for group in board.continual:
+      if (group.stream, group.family, group.profile) == (stream, family, profile):
+        if diagonal:
+          return continual_board.diagonal_table(group)
+        return continual_board.table(group, with_times=False)
+    raise DocTableError(f"no continual record of stream {stream} on {family} at {profile}")
+
+  return table
+
+
 TABLES: dict[str, Callable[[ranking.Leaderboard], Table]] = {
   "headline-spiral": spiral_headline(
     (TENDON_3, TENDON_3_PAPER, LOCAL_3, LOCAL_3_PAPER, PNEUMATIC, PNEUMATIC_PAPER)
@@ -395,4 +415,7 @@ TABLES: dict[str, Callable[[ranking.Leaderboard], Table]] = {
   "exp1s-families-default": exp1s_comparison_table("tendon", "tendon-local", "default"),
   "exp1s-tendon-local-paper": exp1s_table("tendon-local", "paper"),
   "exp1s-families-paper": exp1s_comparison_table("tendon", "tendon-local", "paper"),
+  # A stream's table joins once its records are in (every named table appears in the docs).
+  "continual-grow-tendon-default": continual_table("grow", "tendon", "default"),
+  "continual-grow-tendon-default-diagonal": continual_table("grow", "tendon", "default", True),
 }

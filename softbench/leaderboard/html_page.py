@@ -401,7 +401,10 @@ def render(board: ranking.Leaderboard, results: pathlib.Path, out: pathlib.Path)
     exp1s_heat=lambda entry: _heat_map(exp1s_board.forgetting_table(entry), entry.forgetting()),
     continual=board.continual,
     continual_explanation=continual_board.explanation(),
-    continual_table=continual_board.table,
+    continual_tables=lambda group: (
+      continual_board.table(group),
+      continual_board.diagonal_table(group),
+    ),
     continual_heat=lambda entry: _heat_map(
       continual_board.matrix_table(entry), continual_board.matrix_values(entry)
     ),

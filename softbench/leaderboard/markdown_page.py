@@ -270,7 +270,11 @@ def _exp1s_group(group: exp1s_board.Group, out: pathlib.Path, physics: str = "")
 def _continual_group(
   group: continual_board.Group, out: pathlib.Path, physics: str = ""
 ) -> list[str]:
-  lines = [*_group_heading(group, physics), *table_lines(continual_board.table(group))]
+  lines = [
+    *_group_heading(group, physics),
+    *table_lines(continual_board.table(group)),
+    *table_lines(continual_board.diagonal_table(group)),
+  ]
   for entry in group.entries:
     lines += [
       f"### {_escaped(entry.label)}",

@@ -103,7 +103,11 @@ def exp1s_section(group: exp1s_board.Group) -> str:
 
 def continual_section(group: continual_board.Group) -> str:
   """The title, the strategies' table, each strategy's error matrix and the superseded records."""
-  lines = [group.title, *figure_rows(continual_board.table(group))]
+  lines = [
+    group.title,
+    *figure_rows(continual_board.table(group)),
+    *figure_rows(continual_board.diagonal_table(group)),
+  ]
   for entry in group.entries:
     lines.append(f"  {entry.label}: {entry.path.name}")
     lines += figure_rows(continual_board.matrix_table(entry))
