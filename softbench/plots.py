@@ -12,6 +12,7 @@
 import io
 import math
 import pathlib
+from typing import TYPE_CHECKING
 from typing import Sequence
 
 import matplotlib
@@ -24,8 +25,9 @@ from softbench import episodes
 from softbench import metrics
 from softbench import robots
 from softbench import storage
-from softbench.rendering import scene
-from softbench.robots import base
+
+if TYPE_CHECKING:
+  from softbench.robots.base import SoftArm
 
 DPI = 110  # (dots per inch) of saved figures.
 PANEL_INCHES = 4.0  # Width and height of one 3-D path panel.
@@ -46,10 +48,12 @@ def _save(figure: Figure, path: str | pathlib.Path) -> pathlib.Path:
   return path
 
 
-def _module_colours(robot: base.SoftArm | None, modules: Sequence[int]) -> list:
+def _module_colours(robot: "SoftArm | None", modules: Sequence[int]) -> list:
   """The colour each module is drawn in (as in videos), or matplotlib's cycle without a robot."""
   if robot is None:
     return [f"C{index}" for index in range(len(modules))]
+  from softbench.rendering import scene  # The robot's model (MuJoCo), not needed by other plots.
+
   colours = scene.module_colours(robot.compile(), robot.num_modules)
   return [tuple(colours[module - 1][:3]) for module in modules]
 
@@ -58,7 +62,7 @@ def tracking_paths(
   episode: episodes.Episode,
   path: str | pathlib.Path,
   title: str = "",
-  robot: base.SoftArm | None = None,
+  robot: "SoftArm | None" = None,
 ) -> pathlib.Path:
   """Saves target (dashed) and achieved (solid) tip paths in mm, a 3-D panel per scored module,
   starting at the pose before the first step. A target held all episode is drawn as a star.
@@ -101,7 +105,7 @@ def tracking_errors(
   episodes: Sequence[episodes.Episode],
   path: str | pathlib.Path,
   title: str = "",
-  robot: base.SoftArm | None = None,
+  robot: "SoftArm | None" = None,
 ) -> pathlib.Path:
   """Saves position error (mm), and orientation error (deg) for 6-D targets, over control steps:
   a line per module and episode (seed), the first episode's drawn solid, the others fainter."""

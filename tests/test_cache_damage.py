@@ -14,6 +14,7 @@ import pytest
 from softbench import agents
 from softbench import data
 from softbench import profiles
+from softbench import robots
 from softbench import storage
 from softbench import suite
 from softbench.data import babbling
@@ -48,7 +49,7 @@ def _dataset() -> dict:
 
 
 def _reference() -> dict:
-  made = references.reference(suite.robots.make(ROBOT), "circle", length=4)
+  made = references.reference(robots.make(ROBOT), "circle", length=4)
   return {"poses": made.poses, "actions": made.actions}
 
 
@@ -59,7 +60,7 @@ def _agent() -> dict:
 
 
 def _forward() -> dict:
-  arm = suite.robots.make(ROBOT)
+  arm = robots.make(ROBOT)
   _, (model,) = inverse_training.trained_forward_models(
     arm, [data.View.whole_arm(arm)], 0, profiles.get("tiny")
   )

@@ -47,7 +47,8 @@ def _imported(path: pathlib.Path, module: str, deferred: bool = True) -> frozens
 
 
 def _nodes(tree: ast.AST, deferred: bool):
-  """Every node of ``tree``; without ``deferred``, none within a function's body."""
+  """Every node of ``tree``; without ``deferred``, none within a function's body or an
+  ``if TYPE_CHECKING:`` block (neither runs on import)."""
   if deferred:
     yield from ast.walk(tree)
     return
@@ -59,7 +60,15 @@ def _nodes(tree: ast.AST, deferred: bool):
       child
       for child in ast.iter_child_nodes(node)
       if not isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda))
+      and not _type_checking_only(child)
     )
+
+
+def _type_checking_only(node: ast.AST) -> bool:
+  return isinstance(node, ast.If) and ast.unparse(node.test) in (
+    "TYPE_CHECKING",
+    "typing.TYPE_CHECKING",
+  )
 
 
 def import_graph() -> dict[str, dict[str, list[str]]]:
@@ -148,6 +157,36 @@ def test_each_layer_imports_only_the_layers_below_it(unit, forbidden, why):
   for module in _unit_modules(unit):
     loaded = {_unit(name) for name in _loaded_with(module)}
     assert not loaded & forbidden, f"importing {module} loads {loaded & forbidden} ({why})"
+
+
+# What reading results may not load: a simulator or a learning framework. The records and the
+# leaderboard know robots and tasks from their registries' catalogues (``robots.catalogue``, the
+# task registry), whose engine-bound parts load on first use.
+ENGINES = ("mujoco", "dm_control", "torch")
+READERS = ("leaderboard", "records")
+
+
+@pytest.mark.parametrize("unit", READERS)
+def test_the_records_and_the_leaderboard_import_no_simulator_and_no_torch(unit):
+  for module in _unit_modules(unit):
+    engines = sorted({name.split(".")[0] for name in _loaded_with(module)} & set(ENGINES))
+    assert not engines, f"importing {module} loads {engines} (reading results needs no engine)"
+
+
+def test_reading_every_record_loads_no_engine():
+  # The walk above sees import statements; this runs them, and reads and ranks the committed
+  # records as `softbench leaderboard` does.
+  modules = [module for unit in READERS for module in _unit_modules(unit)]
+  code = (
+    "import importlib, sys\n"
+    f"for module in {modules!r}: importlib.import_module(module)\n"
+    "from softbench import leaderboard\n"
+    f"board = leaderboard.build({str(PACKAGE.parent / 'leaderboard' / 'results')!r})\n"
+    "assert board.groups\n"
+    f"print(sorted(name for name in {ENGINES!r} if name in sys.modules))"
+  )
+  result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+  assert result.stdout.strip() == "[]"
 
 
 # Every module at softbench's top level, and why it is not in a package: a new one says why here.

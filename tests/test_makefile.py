@@ -67,7 +67,7 @@ def test_the_fill_sweeps_every_agent_on_every_task_and_exp1s_then_the_pages(chec
   calls = _fill(checkout)
   axes = grid.lists()
   assert set(axes["agents"]) == set(agents.AGENTS)
-  assert set(axes["families"]) == set(robots.TENDON_FAMILIES)
+  assert set(axes["families"]) == set(robots.TENDON_FAMILY_NAMES)
   assert calls == [
     f"sweep --robots {' '.join(axes['robots'])} --tasks {' '.join(axes['tasks'])} "
     f"--agents {' '.join(axes['agents'])} --protocol exp1s --families "

@@ -17,12 +17,14 @@ import pytest
 
 from softbench.robots import MAX_MODULES
 from softbench.robots import REGISTERED_ROBOTS
-from softbench.robots import TENDON_FAMILIES
+from softbench.robots import TENDON_FAMILY_NAMES
+from softbench.robots import catalogue
+from softbench.robots import family_of
+from softbench.robots import is_tendon
 from softbench.robots import make
 from softbench.robots import measure
 from softbench.robots import payload as payload_model
 from softbench.robots import pneumatic
-from softbench.robots import tendon_family
 from softbench.robots import versions
 from softbench.robots.physics import SoftArmPhysics
 from softbench.robots.tendon import BACKBONES as TENDON_BACKBONES
@@ -292,14 +294,14 @@ def _multi_module_tendon_arms() -> list:
   return [
     pytest.param(name, id=name)
     for name in REGISTERED_ROBOTS
-    if tendon_family(name) and make(name).num_modules > 1
+    if is_tendon(name) and make(name).num_modules > 1
   ]
 
 
 @pytest.mark.parametrize("robot_name", _multi_module_tendon_arms())
 def test_a_module_turns_the_proximal_ones_as_its_family_routes_cables(robot_name):
   robot = make(robot_name)
-  low, high = PROXIMAL_TILT_DEG[tendon_family(robot_name).FAMILY]
+  low, high = PROXIMAL_TILT_DEG[family_of(robot_name).name]
   for module in range(2, robot.num_modules + 1):
     tilts = measure.gravity_free_tilts(robot, module)
     proximal = tilts[: module - 1]
@@ -409,7 +411,24 @@ def test_set_action_rejects_bad_actions(robot_name):
   physics.set_action(-np.ones(dim))
 
 
-@pytest.mark.parametrize("family", TENDON_FAMILIES)
+@pytest.mark.parametrize("name", [*REGISTERED_ROBOTS, "tendon-7", f"tendon-local-{MAX_MODULES}"])
+def test_the_catalogue_knows_a_robot_as_built(name):
+  # What the records and the leaderboard read without MuJoCo is what the built arm says.
+  robot = make(name)
+  assert (catalogue.num_modules(name), catalogue.length(name)) == (robot.num_modules, robot.length)
+  assert catalogue.is_tendon(name) == (family_of(name).name in TENDON_FAMILY_NAMES)
+
+
+@pytest.mark.parametrize("bad", ["tendon-0", "tendon-11", "tendon-03", "x", "tendon-local-x", 3])
+def test_the_catalogue_refuses_a_name_as_make_does(bad):
+  with pytest.raises(ValueError) as built:
+    make(bad)
+  with pytest.raises(ValueError) as counted:
+    catalogue.num_modules(bad)
+  assert str(counted.value) == str(built.value) and "\n" not in str(built.value)
+
+
+@pytest.mark.parametrize("family", TENDON_FAMILY_NAMES)
 @pytest.mark.parametrize("num_modules", range(1, MAX_MODULES + 1))
 def test_every_tendon_arm_builds(family, num_modules):
   robot = make(f"{family}-{num_modules}")

@@ -31,7 +31,8 @@ BEAM_SETTLE_S = 6.0  # (s) Gravity off; the tip moves < 1e-9 m in the last secon
 
 
 def _tendon_arms() -> list[str]:
-  return [f"{family}-{n}" for family in robots.TENDON_FAMILIES for n in robots.BENCHMARK_MODULES]
+  families, sizes = robots.TENDON_FAMILY_NAMES, robots.BENCHMARK_MODULES
+  return [f"{family}-{n}" for family in families for n in sizes]
 
 
 def test_the_reference_covers_every_benchmark_tendon_arm():
@@ -81,7 +82,7 @@ def _last_module(model) -> int:
 def test_a_tip_moment_bends_the_rod_into_a_circle(name, backbone):
   # Constant curvature kappa = M / (E I): the tip lies on a circle of radius 1 / kappa.
   if backbone == "cable" and not versions.cable_plugin_available():
-    pytest.skip(versions.CABLE_PLUGIN_MISSING)
+    pytest.skip(versions.cable_plugin_missing())
   arm = robots.make(name, backbone=backbone)
   length = arm.length
   moment = 1.0 * arm.bending_stiffness / length  # Bends the rod through 1 rad.
@@ -129,7 +130,7 @@ def _elastica_tip(length: float, force: float, bending_stiffness: float) -> np.n
 @pytest.mark.parametrize("backbone", robots.tendon.BACKBONES)
 def test_a_tip_force_bends_the_rod_into_the_elastica(name, backbone):
   if backbone == "cable" and not versions.cable_plugin_available():
-    pytest.skip(versions.CABLE_PLUGIN_MISSING)
+    pytest.skip(versions.cable_plugin_missing())
   arm = robots.make(name, backbone=backbone)
   length = arm.length
   force = 2.0 * arm.bending_stiffness / length**2  # A large deflection: the tip turns ~ 60 deg.
@@ -176,6 +177,6 @@ def test_the_rod_twists_with_g_j_and_bends_with_e_i(name):
 
 @pytest.mark.parametrize("name", robots.REGISTERED_ROBOTS)
 def test_no_benchmark_robot_needs_a_plugin_with_the_rod(name):
-  spec = robots.make(name, **({"backbone": "rod"} if robots.tendon_family(name) else {}))
+  spec = robots.make(name, **({"backbone": "rod"} if robots.is_tendon(name) else {}))
   xml = spec.to_xml()
   assert "<plugin" not in xml and "<extension" not in xml

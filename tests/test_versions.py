@@ -9,6 +9,7 @@ import json
 import pathlib
 import shutil
 
+import mujoco
 import pytest
 
 from softbench import cli
@@ -24,10 +25,11 @@ CHECKOUT = pathlib.Path(__file__).parents[1]
 
 
 def test_the_installed_mujoco_names_one_version():
+  assert versions.engine_version() == mujoco.__version__  # Read from metadata, without MuJoCo.
   here = versions.current()
   assert here.engine_major == versions.engine_major()
   assert versions.cable_plugin_available() == (here.backbone == "cable")
-  for family in robots.TENDON_FAMILIES.values():
+  for family in (robots.family_named(name).arm for name in robots.TENDON_FAMILY_NAMES):
     assert family(num_modules=2).backbone == here.backbone
 
 

@@ -153,7 +153,7 @@ def describe(name: str) -> AgentEntry:
 
 def make(
   name: str,
-  robot: str | robots.SoftArm,
+  robot: "str | robots.SoftArm",
   seed: int = 0,
   profile: str | profiles.Profile = profiles.DEFAULT_PROFILE,
   show_progress: bool = False,
@@ -204,7 +204,7 @@ def learner(name: str) -> Learner | None:
 
 
 def training_summary(
-  name: str, robot: robots.SoftArm, seed: int, profile: profiles.Profile
+  name: str, robot: "robots.SoftArm", seed: int, profile: profiles.Profile
 ) -> dict | None:
   """What an agent that learns by acting spent on ``seed``'s training (environment steps,
   episodes, wall time), read from its cache; None for the other agents."""

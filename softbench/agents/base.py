@@ -13,10 +13,12 @@ trained there if it learns; ``reset`` starts an episode of a given task.
 
 import abc
 import dataclasses
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from softbench.robots import base as robot_base
+if TYPE_CHECKING:
+  from softbench.robots.base import SoftArm
 
 
 @dataclasses.dataclass(frozen=True)
@@ -37,7 +39,7 @@ class Agent(abc.ABC):
 
   uses_simulator = False
 
-  def __init__(self, robot: robot_base.SoftArm, seed: int):
+  def __init__(self, robot: "SoftArm", seed: int):
     self.robot = robot
     self.seed = seed
 

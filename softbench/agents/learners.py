@@ -12,9 +12,12 @@ from collections.abc import Mapping
 import dataclasses
 import importlib
 import numbers
+from typing import TYPE_CHECKING
 
 from softbench import data
-from softbench.robots import base as robot_base
+
+if TYPE_CHECKING:
+  from softbench.robots.base import SoftArm
 
 
 @dataclasses.dataclass(frozen=True)
@@ -72,7 +75,7 @@ RECURRENT = {"hidden_size": Choice((16, 32, 64, 128)), "num_layers": Choice((1, 
 """Width and depth of a recurrent centralised model."""
 
 
-def views(robot: robot_base.SoftArm, per_module: bool) -> list:
+def views(robot: "SoftArm", per_module: bool) -> list:
   """What the controllers read: module k's inputs for column k (``per_module``), else the whole
   arm's (``softbench.data.View``)."""
   return (
@@ -102,5 +105,5 @@ class Learner:
     module, _, name = self.model.partition(":")
     return getattr(importlib.import_module(module), name)
 
-  def views(self, robot: robot_base.SoftArm) -> list:
+  def views(self, robot: "SoftArm") -> list:
     return views(robot, self.per_module)

@@ -49,7 +49,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     "--family",
     help=f"with --protocol {exp1s_records.PROTOCOL} or {continual_records.PROTOCOL}: the tendon "
     f"family of the arms, one of "
-    f"{', '.join(robots.TENDON_FAMILIES)} (default "
+    f"{', '.join(robots.TENDON_FAMILY_NAMES)} (default "
     f"{exp1s_records.DEFAULT_FAMILY})",
   )
   parser.add_argument(

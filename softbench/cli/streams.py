@@ -14,7 +14,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     "--family",
     default="tendon",
     help=f"the tendon family of the configurations shown, one of "
-    f"{', '.join(robots.TENDON_FAMILIES)} (default tendon)",
+    f"{', '.join(robots.TENDON_FAMILY_NAMES)} (default tendon)",
   )
   parser.add_argument("--json", action="store_true", help=arguments.JSON_HELP)
 

@@ -40,7 +40,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     nargs="+",
     metavar="FAMILY",
     help=f"with --protocol {exp1s_records.PROTOCOL} or {continual_records.PROTOCOL}: of "
-    f"{', '.join(robots.TENDON_FAMILIES)} (default {exp1s_records.DEFAULT_FAMILY})",
+    f"{', '.join(robots.TENDON_FAMILY_NAMES)} (default {exp1s_records.DEFAULT_FAMILY})",
   )
   arguments.add_profile_argument(parser)
   parser.add_argument("--seeds", type=int, help=arguments.SEEDS_HELP)

@@ -49,7 +49,9 @@ def _add_setting_arguments(parser: argparse.ArgumentParser) -> None:
   parser.add_argument("--protocol", help=f"{exp1s_records.PROTOCOL}: the Exp1S networks instead")
   parser.add_argument(
     "--family",
-    help=f"with --protocol {exp1s_records.PROTOCOL}: one of {', '.join(robots.TENDON_FAMILIES)}",
+    help=(
+      f"with --protocol {exp1s_records.PROTOCOL}: one of {', '.join(robots.TENDON_FAMILY_NAMES)}"
+    ),
   )
   parser.add_argument(
     "--seeds",

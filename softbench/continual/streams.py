@@ -44,7 +44,7 @@ class Configuration:
   """One stage's robot, and how tables name it (``tendon-2``, ``cables 75 %``, ``10 g``)."""
 
   label: str
-  robot: robots.SoftArm
+  robot: "robots.SoftArm"
 
   def describe(self) -> dict:
     """The configuration as a record holds it: label, robot name, faults and payload."""
@@ -76,9 +76,9 @@ class Stream:
 
 
 def check_family(family: str) -> None:
-  if family not in robots.TENDON_FAMILIES:
+  if family not in robots.TENDON_FAMILY_NAMES:
     raise ValueError(
-      f"unknown tendon family {family!r}; choose one of {', '.join(robots.TENDON_FAMILIES)}"
+      f"unknown tendon family {family!r}; choose one of {', '.join(robots.TENDON_FAMILY_NAMES)}"
     )
 
 

@@ -33,7 +33,7 @@ class RecordFilter:
       ValueError: an unknown robot, task, agent, profile or physics version (one line).
     """
     for robot in self.robots:
-      robot_registry.make(robot)
+      robot_registry.checked_family(robot)
     for task in self.tasks:
       if task not in suite.TASKS:
         raise ValueError(f"unknown task {task!r}; choose from {', '.join(suite.TASKS)}")

@@ -14,5 +14,5 @@ def lists() -> dict[str, tuple[str, ...]]:
     "robots": ROBOTS,
     "tasks": tuple(task for task in suite.TASKS if "benchmarking" in suite.describe(task).tags),
     "agents": agents.AGENTS,
-    "families": tuple(robots.TENDON_FAMILIES),
+    "families": tuple(robots.TENDON_FAMILY_NAMES),
   }

@@ -18,5 +18,4 @@ def paper_robot(robot: str) -> str:
   """The name under which the paper's tables hold ``robot``: a tendon arm of any family is the
   paper's arm of as many modules (its tables are keyed ``tendon-N``; the paper's simulator acts
   within each module, like ``tendon-local-N``, and softbench compares both plants with it)."""
-  family = robots.tendon_family(robot)
-  return f"tendon-{robots.make(robot).num_modules}" if family else robot
+  return f"tendon-{robots.num_modules(robot)}" if robots.is_tendon(robot) else robot

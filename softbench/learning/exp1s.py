@@ -24,9 +24,9 @@ from softbench.records.exp1s import PROTOCOL
 def protocol(family: str = DEFAULT_FAMILY) -> protocols.Protocol:
   """Exp1S on the arms of tendon family ``family``; raises a one-line ValueError for an unknown
   family."""
-  if family not in robots.TENDON_FAMILIES:
+  if family not in robots.TENDON_FAMILY_NAMES:
     raise ValueError(
-      f"unknown tendon family {family!r}; choose one of {', '.join(robots.TENDON_FAMILIES)}"
+      f"unknown tendon family {family!r}; choose one of {', '.join(robots.TENDON_FAMILY_NAMES)}"
     )
   return protocols.get(PROTOCOL).on_family(family)
 

@@ -419,7 +419,7 @@ def _check_consistency(record: dict, refuse: record_fields.Refuse) -> None:
   record_fields.check(record, refuse, seed_entries=0 if adaptive else None)
   per_seed = record["per_seed"]
   try:
-    num_modules = robots.make(record["robot"]).num_modules
+    num_modules = robots.num_modules(record["robot"])
   except ValueError as error:
     refuse(f"robot: {error}")
   if max(record["scored_modules"]) > num_modules:

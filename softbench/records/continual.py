@@ -94,7 +94,7 @@ def schema() -> dict:
     "version": {"const": VERSION},
     "protocol": {"const": PROTOCOL},
     "stream": {"type": "string", "pattern": record_fields.AGENT_PATTERN},
-    "family": {"enum": list(robots.TENDON_FAMILIES)},
+    "family": {"enum": list(robots.TENDON_FAMILY_NAMES)},
     "task": {"type": "string", "minLength": 1},
     "configurations": {"type": "array", "items": configuration, "minItems": 1},
     "per_seed": {"type": "array", "items": seed, "minItems": 1},
@@ -119,7 +119,7 @@ def check(record: dict, refuse: record_fields.Refuse) -> None:
   lengths_mm = []
   for configuration in record["configurations"]:
     try:
-      lengths_mm.append(robots.make(configuration["robot"]).length * metrics.MM_PER_M)
+      lengths_mm.append(robots.length(configuration["robot"]) * metrics.MM_PER_M)
     except ValueError as error:
       refuse(f"configurations: {error}")
   for index, entry in enumerate(record["per_seed"]):

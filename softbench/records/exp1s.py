@@ -94,7 +94,7 @@ def check(record: dict, refuse: record_fields.Refuse) -> None:
   lengths_mm = {}
   for name in record["robots"]:
     try:
-      lengths_mm[name] = robots.make(name).length * metrics.MM_PER_M
+      lengths_mm[name] = robots.length(name) * metrics.MM_PER_M
     except ValueError as error:
       refuse(f"robots: {error}")
   if FORGETTING_TASK not in record["tasks"]:

@@ -16,12 +16,13 @@ import mujoco
 import numpy as np
 
 from softbench.robots import base
+from softbench.robots import catalogue
 from softbench.robots import chain
 from softbench.robots import faults as fault_model
 from softbench.robots import payload as payload_model
 
-MODULE_LENGTH = 0.08  # (m) Paper: "Each actuator is 80mm long".
-BELLOWS_PER_MODULE = (4, 3, 3)  # Paper: 4 at 90 degrees at the base, then 3 at 120 degrees.
+MODULE_LENGTH = catalogue.PNEUMATIC_MODULE_LENGTH  # (m)
+BELLOWS_PER_MODULE = catalogue.PNEUMATIC_BELLOWS
 MIN_PRESSURE, MAX_PRESSURE = -40.0, 90.0  # (kPa) Paper: "-40KPa" and "90 KPa".
 MIN_LENGTH_RATIO, MAX_LENGTH_RATIO = 0.7, 1.2  # Paper: 70 % contraction, 120 % elongation.
 _MODULE_RGBA = ((0.90, 0.35, 0.25, 1), (0.35, 0.70, 0.35, 1), (0.25, 0.55, 0.85, 1))

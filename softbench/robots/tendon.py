@@ -21,20 +21,20 @@ module-local family, ``tendon-local-N``.
 import abc
 import dataclasses
 import math
-import re
 from typing import ClassVar
 
 import mujoco
 import numpy as np
 
 from softbench.robots import base
+from softbench.robots import catalogue
 from softbench.robots import chain
 from softbench.robots import faults as fault_model
 from softbench.robots import payload as payload_model
 from softbench.robots import versions
 
-MODULE_LENGTH = 0.05  # (m) Paper: "Each module has a length of 50 mm".
-MAX_MODULES = 10  # Largest N that builds; N = 1 .. 5 are the benchmark configurations.
+MODULE_LENGTH = catalogue.TENDON_MODULE_LENGTH  # (m)
+MAX_MODULES = catalogue.MAX_MODULES  # Largest N that builds; N = 1 .. 5 are the benchmark ones.
 BACKBONES = ("rod", "cable")  # versions.PhysicsVersion.backbone of physics v1 and v0.
 # Cables, as (name, angle around the arm in degrees, action axis, sign of the action that pulls it).
 _CABLES = (
@@ -143,23 +143,17 @@ class CableDrivenArm(base.SoftArm):
     if self.backbone not in BACKBONES:
       raise ValueError(f"unknown backbone {self.backbone!r}; choose one of {', '.join(BACKBONES)}")
     if self.backbone == "cable" and not versions.cable_plugin_available():
-      raise ValueError(versions.CABLE_PLUGIN_MISSING)
+      raise ValueError(versions.cable_plugin_missing())
     fault_model.check(self, self.faults)
     payload_model.check(self.payload)
 
   @classmethod
   def from_name(cls, name: str, **overrides) -> "CableDrivenArm":
     """``TendonArm.from_name('tendon-3')``; raises ValueError for a malformed name."""
-    # Canonical names only: ASCII digits, no leading zero, no surrounding space.
-    match = re.fullmatch(rf"{re.escape(cls.FAMILY)}-(0|[1-9][0-9]{{0,3}})", name, re.ASCII)
-    if not match:
-      raise ValueError(
-        f"malformed {cls.FAMILY} arm name {name[:40]!r}; expected "
-        f"{cls.FAMILY}-N with N from 1 to {MAX_MODULES}"
-      )
+    num_modules = catalogue.family_named(cls.FAMILY).num_modules(name)
     if "num_modules" in overrides:
       raise ValueError(f"{name!r} names its number of modules; drop num_modules")
-    return cls(num_modules=int(match.group(1)), **overrides)
+    return cls(num_modules=num_modules, **overrides)
 
   @property
   def name(self) -> str:

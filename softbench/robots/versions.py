@@ -16,8 +16,7 @@ The installed MuJoCo decides the current version; one process runs one version.
 
 import dataclasses
 import functools
-
-import mujoco
+from importlib import metadata
 
 
 @dataclasses.dataclass(frozen=True)
@@ -75,16 +74,21 @@ VERSIONS = {
 FIRST = "v0"
 LATEST = "v1"
 
-CABLE_PLUGIN_MISSING = (
-  "the cable backbone needs MuJoCo 3's cable plugin (physics v0), which MuJoCo "
-  f"{mujoco.__version__} lacks; use backbone='rod' or install the old stack: "
-  + VERSIONS["v0"].install
-)
 
-
+@functools.cache
 def engine_version() -> str:
-  """The installed MuJoCo's version, e.g. ``4.0.1``."""
-  return mujoco.__version__
+  """The installed MuJoCo's version, e.g. ``4.0.1`` (from its package's metadata: reading it
+  loads no simulator, so the records and the leaderboard know the version without MuJoCo)."""
+  return metadata.version("mujoco")
+
+
+def cable_plugin_missing() -> str:
+  """Why a cable backbone does not build here (one line)."""
+  return (
+    "the cable backbone needs MuJoCo 3's cable plugin (physics v0), which MuJoCo "
+    f"{engine_version()} lacks; use backbone='rod' or install the old stack: "
+    + VERSIONS["v0"].install
+  )
 
 
 def engine_major() -> int:
@@ -105,6 +109,8 @@ def current() -> PhysicsVersion:
 def cable_plugin_available() -> bool:
   """Whether this MuJoCo has the ``mujoco.elasticity.cable`` plugin (a model that asks for it
   loads)."""
+  import mujoco  # The engine itself, only here: the rest of this module reads metadata.
+
   try:
     mujoco.MjModel.from_xml_string(_CABLE_PROBE)
   except ValueError:
@@ -137,6 +143,6 @@ def check(name: str) -> PhysicsVersion:
   if version != current():
     raise ValueError(
       f"physics {name} ({version.description}) needs {version.engine}, but MuJoCo "
-      f"{mujoco.__version__} is installed (physics {current().name}); {version.install}"
+      f"{engine_version()} is installed (physics {current().name}); {version.install}"
     )
   return version

@@ -423,7 +423,7 @@ def table(record: dict) -> str:
 
 def family_of(record: dict) -> str:
   """The tendon family of an Exp1S record's configurations."""
-  return robots.tendon_family(record["robots"][0]).FAMILY
+  return robots.family_of(record["robots"][0]).name
 
 
 def finish(record: dict, files: list[pathlib.Path]) -> None:

@@ -108,7 +108,7 @@ def rescored(record: dict, seed: int) -> dict:
   if record["format"] == continual.RECORD_FORMAT:
     family = next(
       name
-      for name in robots.TENDON_FAMILIES
+      for name in robots.TENDON_FAMILY_NAMES
       if exp1s_training.protocol(name).robot_names == tuple(record["robots"])
     )
     with tempfile.TemporaryDirectory() as kept:

@@ -14,8 +14,9 @@ import numpy as np
 
 from softbench.robots import base
 from softbench.robots import physics as arm_physics
+from softbench.suite import registry
 
-INITIAL_ACTUATION = 0.2  # Largest |action| entry of the random actuation held before an episode.
+INITIAL_ACTUATION = registry.INITIAL_ACTUATION  # Largest |action| of the start's random hold.
 REWARD_TOLERANCE = 0.01  # Fraction of the arm length within which the reward is 1.
 REWARD_MARGIN = 0.1  # Fraction of the arm length beyond the tolerance at which the reward is
 # 0.1 (dm_control measures the margin from the bound: 0.1 at 11 % of the arm length).

@@ -16,11 +16,9 @@ reference once: the others wait for it (``storage.found_or_made``). The generati
 stored for replay checks; tasks show controllers only the poses.
 """
 
-from collections.abc import Callable
 import dataclasses
 import functools
 import hashlib
-import inspect
 import json
 import os
 import pathlib
@@ -36,77 +34,12 @@ from softbench.robots import base
 from softbench.robots import recorder
 from softbench.suite import registry
 
-REFERENCE_LENGTH = 1000  # Target poses per reference (paper: 1,000 samples per trajectory).
+REFERENCE_LENGTH = registry.REFERENCE_LENGTH  # Target poses per reference.
 BEND_DEG = 60.0  # (deg) End-effector bend at one bend amplitude.
 AMPLITUDE_GRID = np.linspace(0.05, 1.0, 20)  # Actuations tried when calibrating the amplitude.
 SETTLE_SECONDS = 3.0  # (s) Hold per calibration actuation; longer than any settling time.
 FORMAT_VERSION = 2  # 2: a shape's key holds its own parameters only (1: every shape's).
 FOLDER = "references"  # In the data home.
-_FIXED_ARGUMENTS = {True: ("length",), False: ("robot", "length")}  # Of a planar shape, of others.
-
-
-@dataclasses.dataclass(frozen=True)
-class Shape:
-  """How a tracking task's reference is traced: ``trace(length, **parameters)`` gives (length, 2)
-  points of the planar actuation space in bend amplitudes (``planar``), else
-  ``trace(robot, length, **parameters)`` gives the robot's actions (length, action_dim) in
-  [-1, 1]. Its parameters are the defaults of its other arguments (numbers, strings, or lists
-  and tuples of them): the cache key of its references hashes them, and no other shape's."""
-
-  name: str
-  trace: Callable[..., np.ndarray]
-  planar: bool = True
-
-  def __post_init__(self):
-    arguments = list(inspect.signature(self.trace).parameters.values())
-    fixed = _FIXED_ARGUMENTS[self.planar]
-    if tuple(argument.name for argument in arguments[: len(fixed)]) != fixed:
-      raise ValueError(
-        f"shape {self.name!r}: {self.trace.__name__} must take ({', '.join(fixed)}, ...) first"
-      )
-    for argument in arguments[len(fixed) :]:
-      if argument.default is inspect.Parameter.empty:
-        raise ValueError(f"shape {self.name!r}: parameter {argument.name!r} needs a default")
-    try:
-      json.dumps(self.parameters, allow_nan=False)
-    except (TypeError, ValueError) as error:
-      raise ValueError(
-        f"shape {self.name!r}: parameters must be numbers, strings or lists of them ({error})"
-      ) from None
-
-  @property
-  def parameters(self) -> dict:
-    """The defaults of ``trace``'s arguments after the robot and the length, by name."""
-    arguments = list(inspect.signature(self.trace).parameters.values())
-    return {
-      argument.name: argument.default
-      for argument in arguments[len(_FIXED_ARGUMENTS[self.planar]) :]
-    }
-
-  def actions(self, robot: base.SoftArm, length: int, amplitude: float | None) -> np.ndarray:
-    """The actions (length, action_dim) that trace the shape on ``robot``; a planar shape's
-    points are scaled by ``amplitude`` (default ``bend_amplitude(robot)``).
-
-    Raises:
-      ValueError: ``trace`` gave an array of another shape, values that are not finite, or
-        actions out of [-1, 1] (one line).
-    """
-    if not self.planar:
-      actions = self._checked(self.trace(robot, length), (length, robot.action_dim))
-      if np.any(np.abs(actions) > 1.0):
-        raise ValueError(f"shape {self.name!r} gave actions out of [-1, 1]")
-      return actions
-    points = self._checked(self.trace(length), (length, 2))
-    amplitude = bend_amplitude(robot) if amplitude is None else amplitude
-    return robot.planar_action(amplitude * points)
-
-  def _checked(self, traced, expected: tuple[int, ...]) -> np.ndarray:
-    traced = np.asarray(traced, dtype=float)
-    if traced.shape != expected:
-      raise ValueError(f"shape {self.name!r} gave an array {traced.shape}, not {expected}")
-    if not np.all(np.isfinite(traced)):
-      raise ValueError(f"shape {self.name!r} gave NaN or infinite values")
-    return traced
 
 
 @functools.lru_cache(maxsize=None)
@@ -142,7 +75,7 @@ def bend_amplitude(robot: base.SoftArm) -> float:
   )
 
 
-def shape_named(name: str) -> Shape:
+def shape_named(name: str) -> registry.Shape:
   """The reference shape of tracking task ``name``.
 
   Raises:
@@ -160,7 +93,10 @@ def pattern_actions(
 ) -> np.ndarray:
   """The generating actions (length, action_dim) of reference ``name``; a planar shape's
   ``amplitude`` is ``bend_amplitude(robot)`` unless given."""
-  return shape_named(name).actions(robot, length, amplitude)
+  shape = shape_named(name)
+  if shape.planar and amplitude is None:
+    amplitude = bend_amplitude(robot)
+  return shape.actions(robot, length, amplitude)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -178,7 +114,7 @@ class Reference:
     return self.poses[1:]
 
 
-def _config(robot: base.SoftArm, shape: Shape, length: int) -> dict:
+def _config(robot: base.SoftArm, shape: registry.Shape, length: int) -> dict:
   """What a reference depends on, as its cache's description stores it: the robot, the length,
   the shape's own parameters and, for a planar shape, the calibration of ``bend_amplitude``."""
   config = {

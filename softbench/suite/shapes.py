@@ -14,11 +14,15 @@ A new one is a function here (or in your own module) under ``suite.tracking_task
 parameters are its arguments' defaults, and only they key its cached references.
 """
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from softbench.data import seeding
-from softbench.robots import base
-from softbench.suite import tracking
+from softbench.suite.registry import tracking_task
+
+if TYPE_CHECKING:
+  from softbench.robots.base import SoftArm
 
 CIRCLE_RADIUS = 0.8  # (bend amplitudes)
 CIRCLE_TURNS = 4
@@ -46,9 +50,9 @@ def grown(length: int, lead_in: float) -> np.ndarray:
 
 
 # The paper runs its Exp2S tracking on the tendon arm (each task's default robot, tendon-3).
-@tracking.tracking_task("follow held-out poses produced by random actuation", planar=False)
+@tracking_task("follow held-out poses produced by random actuation", planar=False)
 def babbling(
-  robot: base.SoftArm,
+  robot: "SoftArm",
   length: int,
   seed: int = BABBLING_SEED,
   stream: int = seeding.HELD_OUT_BABBLING_STREAM,
@@ -57,7 +61,7 @@ def babbling(
   return seeding.rng(seed, stream).uniform(-1.0, 1.0, (length, robot.action_dim))
 
 
-@tracking.tracking_task("follow a circle traced in actuation space")
+@tracking_task("follow a circle traced in actuation space")
 def circle(
   length: int, radius: float = CIRCLE_RADIUS, turns: int = CIRCLE_TURNS, lead_in: float = LEAD_IN
 ) -> np.ndarray:
@@ -65,7 +69,7 @@ def circle(
   return grown(length, lead_in) * on_circle(radius, phases(length, turns))
 
 
-@tracking.tracking_task("follow a rectangle traced in actuation space")
+@tracking_task("follow a rectangle traced in actuation space")
 def rectangle(
   length: int,
   half_sides: tuple[float, float] = RECTANGLE_HALF_SIDES,
@@ -85,7 +89,7 @@ def rectangle(
   return grown(length, lead_in) * path
 
 
-@tracking.tracking_task("follow a growing spiral traced in actuation space")
+@tracking_task("follow a growing spiral traced in actuation space")
 def spiral(length: int, turns: int = SPIRAL_TURNS) -> np.ndarray:
   """``turns`` turns whose radius grows linearly from 0 to 1."""
   return on_circle(phases(length, 1.0), phases(length, turns))

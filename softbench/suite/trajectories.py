@@ -137,6 +137,12 @@ def as_given(given, robot: base.SoftArm) -> Given | None:
   raise ValueError(f"given must be None, a Given or text such as '2:position', got {given!r}")
 
 
+def leaves_part_out(robot: base.SoftArm, options: dict) -> bool:
+  """Whether task ``custom`` with ``options`` gives only part of ``robot``'s pose (its
+  ``TaskEntry.partial_targets``)."""
+  return as_given(options.get("given"), robot) not in (None, Given.whole(robot))
+
+
 def _read(path: pathlib.Path) -> np.ndarray:
   try:  # A FIFO would wait for a writer forever: named as what it is.
     storage.check_regular_file(path, "trajectory file")

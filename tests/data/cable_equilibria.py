@@ -23,7 +23,7 @@ from softbench.robots import measure
 from softbench.robots import versions
 from softbench.storage import write_atomically
 
-ROBOTS = tuple(f"{family}-{n}" for family in robots.TENDON_FAMILIES for n in range(1, 6))
+ROBOTS = tuple(f"{family}-{n}" for family in robots.TENDON_FAMILY_NAMES for n in range(1, 6))
 ACTIONS_PER_ROBOT = 8
 HOLD_S = 4.0  # (s)
 SETTLED_MM = 1e-3  # (mm) Largest tip movement between HOLD_S and 2 HOLD_S of an equilibrium.
@@ -50,7 +50,7 @@ def equilibria(name: str) -> dict:
 
 def main() -> None:
   if not versions.cable_plugin_available():
-    sys.exit(f"error: {versions.CABLE_PLUGIN_MISSING}")
+    sys.exit(f"error: {versions.cable_plugin_missing()}")
   reference = {
     "made_with": f"mujoco {mujoco.__version__}, backbone cable (physics v0)",
     "date": datetime.date.today().isoformat(),
