@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 import torch
 
-from smpl import training
+from smpl import fitting
 from softbench import agents
 from softbench import data
 from softbench import profiles
@@ -36,7 +36,7 @@ _LEARNED_AGENTS = tuple(name for name in agents.AGENTS if agents.describe(name).
 
 @pytest.fixture(autouse=True)
 def _training_thread_count() -> Iterator[None]:
-  with training.limited_cpu_threads(training.CPU_THREADS, torch.device("cpu")):
+  with fitting.limited_cpu_threads(fitting.CPU_THREADS, torch.device("cpu")):
     yield
 
 

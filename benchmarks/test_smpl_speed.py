@@ -11,11 +11,11 @@ from collections.abc import Iterator
 import pytest
 import torch
 
+from smpl.fitting import CPU_THREADS
+from smpl.fitting import limited_cpu_threads
 from smpl.forward_model import ForwardModel
 from smpl.progressive import ProgressiveLSTM
-from smpl.training import CPU_THREADS
 from smpl.training import InverseTrainingConfig
-from smpl.training import limited_cpu_threads
 from smpl.training import train_inverse_model
 from smpl.windows import SEQUENCE_LENGTH
 from smpl.windows import BabblingWindows

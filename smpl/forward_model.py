@@ -29,7 +29,7 @@ class ForwardModel(nn.Module):
 
   compiles_on_cpu = False
   """Inductor (torch 2.13) cannot compile the CPU's fused nn.LSTM (`aten.mkldnn_rnn_layer`
-    fails with "expected Tensor()"), which this model runs over whole windows; `smpl.training.fit`
+    fails with "expected Tensor()"), which this model runs over whole windows; `smpl.fitting.fit`
     trains it eagerly on the CPU rather than fail, warn and fall back."""
 
   def __init__(

@@ -33,7 +33,7 @@ class InverseModel(nn.Module, ABC):
   input_size: int
   action_size: int
   compiles_on_cpu: bool = True
-  """Whether `torch.compile` can compile this model's training on the CPU (`smpl.training.fit`
+  """Whether `torch.compile` can compile this model's training on the CPU (`smpl.fitting.fit`
     trains it eagerly there if not)."""
 
   @abstractmethod

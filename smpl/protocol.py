@@ -20,15 +20,15 @@ import torch
 from torch import Tensor
 from torch import nn
 
+from smpl.fitting import CPU_THREADS
+from smpl.fitting import EpochReport
+from smpl.fitting import TrainingResult
+from smpl.fitting import limited_cpu_threads
+from smpl.fitting import seeded
 from smpl.forward_model import ForwardModel
 from smpl.progressive import ProgressiveLSTM
 from smpl.rollout import rollout
-from smpl.training import CPU_THREADS
-from smpl.training import EpochReport
 from smpl.training import InverseTrainingConfig
-from smpl.training import TrainingResult
-from smpl.training import limited_cpu_threads
-from smpl.training import seeded
 from smpl.training import train_inverse_model
 from smpl.windows import BabblingWindows
 from smpl.windows import inverse_input_size

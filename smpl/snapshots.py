@@ -1,4 +1,4 @@
-"""Resumable training: `smpl.training.fit` keeps its state in a snapshot file and resumes from it.
+"""Resumable training: `smpl.fitting.fit` keeps its state in a snapshot file and resumes from it.
 
 Inside `with resumable(folder):` the n-th call of `fit` keeps its state in `folder/fit-<n>.pt`,
 saved atomically at most every `SAVE_INTERVAL_S` seconds and when it ends. A training run calls

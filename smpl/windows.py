@@ -167,7 +167,7 @@ class ModuleWindows:
   """Time-aligned windows of every module of one arm (window i of each module covers the same
   control steps), for training a distributed controller's columns together.
 
-  It offers what `smpl.training.fit` uses of BabblingWindows: `len`, `subset`, `to`, `actions`,
+  It offers what `smpl.fitting.fit` uses of BabblingWindows: `len`, `subset`, `to`, `actions`,
   `tensors`.
   """
 

@@ -17,7 +17,7 @@ class Profile:
   max_epochs: int  # Epoch budget of every model (forward and inverse).
   patience: int  # Epochs without a better validation loss before training stops.
   seeds: int  # Training and evaluation seeds.
-  compile: bool  # torch.compile the training step (smpl.training.TrainingConfig.compile).
+  compile: bool  # torch.compile the training step (smpl.fitting.TrainingConfig.compile).
   episode_length: int | None = None  # Control steps per episode (suite.length_options); None:
   # the task's default.
 

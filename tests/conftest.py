@@ -14,8 +14,8 @@ import gymnasium
 import pytest
 import worker_hooks
 
+from smpl import fitting
 from smpl import snapshots
-from smpl import training
 from softbench import data
 from softbench import leaderboard
 from softbench import profiles
@@ -149,7 +149,7 @@ def interrupted_training(monkeypatch):
 
   @contextlib.contextmanager
   def interrupted():
-    epochs, train_epoch = 0, training._train_epoch
+    epochs, train_epoch = 0, fitting._train_epoch
 
     def interrupted_in_the_fourth_epoch(*args):
       nonlocal epochs
@@ -159,7 +159,7 @@ def interrupted_training(monkeypatch):
       return train_epoch(*args)
 
     with monkeypatch.context() as patched:
-      patched.setattr(training, "_train_epoch", interrupted_in_the_fourth_epoch)
+      patched.setattr(fitting, "_train_epoch", interrupted_in_the_fourth_epoch)
       with pytest.raises(KeyboardInterrupt):
         yield
 

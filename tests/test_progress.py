@@ -10,7 +10,7 @@ import re
 import pytest
 from rich import progress as rich_progress
 
-from smpl import training
+from smpl import fitting
 from softbench import progress
 from softbench.sweep import display
 
@@ -115,8 +115,8 @@ def _clocked(monkeypatch) -> list[float]:
   return now
 
 
-def _report(epoch: int, resumed: bool) -> training.EpochReport:
-  return training.EpochReport(epoch, 1.0, 1.0, 1.0, False, 8.0, resumed)
+def _report(epoch: int, resumed: bool) -> fitting.EpochReport:
+  return fitting.EpochReport(epoch, 1.0, 1.0, 1.0, False, 8.0, resumed)
 
 
 def test_a_resumed_trainings_relayed_bar_takes_its_pace_from_the_epochs_run_since(

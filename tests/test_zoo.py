@@ -8,7 +8,7 @@ import shutil
 import numpy as np
 import pytest
 
-from smpl import training
+from smpl import fitting
 from softbench import agents
 from softbench import cli
 from softbench import leaderboard
@@ -60,7 +60,7 @@ def no_training(monkeypatch):
   def refuse(*args, **kwargs):
     raise AssertionError("trained or collected although the zoo holds the weights")
 
-  monkeypatch.setattr(training, "fit", refuse)
+  monkeypatch.setattr(fitting, "fit", refuse)
   monkeypatch.setattr(protocols, "prepare_column", refuse)
   monkeypatch.setattr(learned.data, "collect", refuse)
 

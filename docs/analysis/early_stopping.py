@@ -16,6 +16,7 @@ import dataclasses
 
 import torch
 
+from smpl import fitting
 from smpl import training
 from softbench import agents
 from softbench import profiles
@@ -48,12 +49,12 @@ def main() -> None:
   params = hyperparameters.values(args.agent, arm.name)
   _, config = inverse_training.training_configs(args.seed, profile, params)
   config = dataclasses.replace(config, max_epochs=args.epochs, patience=args.epochs + 1)
-  with training.seeded(args.seed, torch.device("cpu")):
+  with fitting.seeded(args.seed, torch.device("cpu")):
     inverse = inverse_training._inverse_model(views, False, learner.make_model, params)
 
   kept = {}
 
-  def keep(report: training.EpochReport) -> None:
+  def keep(report: fitting.EpochReport) -> None:
     epoch = report.epoch + 1  # Epochs trained so far.
     print(
       f"epoch {epoch}: training loss {report.train_loss:.4f}, "
@@ -69,7 +70,7 @@ def main() -> None:
     windows[0].train,
     windows[0].validation,
     config,
-    training.default_device(),
+    fitting.default_device(),
     keep,
     restart_diverged=True,
   )

@@ -25,6 +25,7 @@ import time
 
 import torch
 
+from smpl import fitting
 from smpl import training
 from smpl import windows as smpl_windows
 from softbench import leaderboard
@@ -82,11 +83,11 @@ def main() -> None:
   views = learners.views(arm, per_module=True)
   params = hyperparameters.values("smpl", arm.name)
   settings = run_settings.settings(args.task, "smpl", args.robot, seeds=1, profile=args.profile)
-  device = training.default_device()
+  device = fitting.default_device()
   for seed in args.seeds:
     windows, forwards = inverse_training.trained_forward_models(arm, views, seed, profile)
     check_preceding_is_proximal(windows)
-    with training.seeded(seed, torch.device("cpu")):
+    with fitting.seeded(seed, torch.device("cpu")):
       network, _ = inverse_training.untrained(views, True, None, params)
     network.requires_grad_(True)  # Adding a column froze the ones before it.
     _, config = inverse_training.training_configs(seed, profile, params)
@@ -95,7 +96,7 @@ def main() -> None:
       model.to(device).eval()
     split = lambda part: smpl_windows.ModuleWindows(tuple(getattr(w, part) for w in windows))
     started = time.perf_counter()
-    result = training.fit(
+    result = fitting.fit(
       network,
       training.joint_action_loss(
         network,

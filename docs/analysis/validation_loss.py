@@ -12,6 +12,7 @@ Usage:
 
 import argparse
 
+from smpl import fitting
 from smpl import training
 from softbench import agents
 from softbench import profiles
@@ -43,8 +44,8 @@ def main() -> None:
       def loss(batch, inverse=agent.inverse, forward=forward):
         return training.inverse_model_loss(inverse, forward, batch, include_aux_loss=False)
 
-      validation = training.evaluate_loss(agent.inverse, loss, windows.validation)
-      test = training.evaluate_loss(agent.inverse, loss, windows.test)
+      validation = fitting.evaluate_loss(agent.inverse, loss, windows.validation)
+      test = fitting.evaluate_loss(agent.inverse, loss, windows.test)
       print(
         f"{name} seed {seed}: validation loss {validation:.4f}, test loss {test:.4f}", flush=True
       )

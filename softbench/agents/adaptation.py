@@ -33,6 +33,7 @@ import time
 import torch
 
 from smpl import checkpoint
+from smpl import fitting
 from smpl import progressive
 from smpl import training
 from smpl import windows as smpl_windows
@@ -207,7 +208,7 @@ def _retrain(
   forward_config, inverse_config = inverse_training.training_configs(
     seed, profile, hyperparameters.values("smpl", agent.robot.name)
   )
-  device = training.default_device()
+  device = fitting.default_device()
   label = f"{dataset.robot_name} seed {seed}"
   for index in range(module - 1, len(forwards)):
     forwards[index].requires_grad_(True)

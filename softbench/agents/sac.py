@@ -23,8 +23,8 @@ from stable_baselines3.common import logger as sb3_logger
 from stable_baselines3.common import vec_env
 import torch
 
+from smpl import fitting
 from smpl import snapshots
-from smpl import training
 from softbench import data
 from softbench import profiles
 from softbench import progress as progress_bars
@@ -302,8 +302,8 @@ def _trained(
     "sac training state",
     "training from the start",
   )
-  device = training.default_device()
-  with training.limited_cpu_threads(training.CPU_THREADS, device):
+  device = fitting.default_device()
+  with fitting.limited_cpu_threads(fitting.CPU_THREADS, device):
     venv, stream_env = _training_env(robot, config, state["episode_under_way"] if state else 0)
     if state is None:
       model = stable_baselines3.SAC(

@@ -18,9 +18,9 @@ import time
 
 import torch
 
+from smpl import fitting
 from smpl import rollout as smpl_rollout
 from smpl import snapshots
-from smpl import training
 from softbench import data
 from softbench import profiles
 from softbench import progress as progress_bars
@@ -125,7 +125,7 @@ def setting(
     pose_sizes.pop(),
     tuple(stage.action_size for stage in stages),
     inverse_config,
-    training.default_device(),
+    fitting.default_device(),
   )
 
 
@@ -135,7 +135,7 @@ def model_scores(
   """Pose and action MSE (normalised) of configurations 0..``upto`` on their test windows, closed
   loop through their forward models."""
   scores = {"model_pose_mse": [], "model_action_mse": []}
-  with torch.no_grad(), training.limited_cpu_threads(training.CPU_THREADS, torch.device("cpu")):
+  with torch.no_grad(), fitting.limited_cpu_threads(fitting.CPU_THREADS, torch.device("cpu")):
     for configuration in range(upto + 1):
       test = stages[configuration].windows.test
       result = smpl_rollout.rollout(

@@ -22,7 +22,7 @@ import numpy as np
 import torch
 
 import smpl
-from smpl import training
+from smpl import fitting
 import softbench
 from softbench import episodes
 from softbench import storage
@@ -47,8 +47,8 @@ def source_sha256() -> str:
 
 
 def _device() -> str:
-  """The device the run's agents train on (``smpl.training.default_device``)."""
-  return str(training.default_device())
+  """The device the run's agents train on (``smpl.fitting.default_device``)."""
+  return str(fitting.default_device())
 
 
 def keyed_folder(name: str, settings) -> pathlib.Path:

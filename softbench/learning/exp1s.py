@@ -7,8 +7,8 @@ import pathlib
 
 import numpy as np
 
+from smpl import fitting
 from smpl import protocol as smpl_protocol
-from smpl import training
 from softbench import profiles
 from softbench import progress as progress_bars
 from softbench import robots
@@ -77,7 +77,7 @@ def _train(
     inverse_training.DATA_SEED,
     forward_config,
     inverse_config,
-    training.default_device(),
+    fitting.default_device(),
     show,
     epoch_bars,
   )

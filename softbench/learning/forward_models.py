@@ -15,6 +15,7 @@ import dataclasses
 import pathlib
 
 from smpl import checkpoint
+from smpl import fitting
 from smpl import forward_model as smpl_forward
 from smpl import snapshots
 from smpl import training
@@ -112,7 +113,7 @@ def prepare(
         ) as bar,
       ):
         column = protocols.prepare_column(
-          robot, view, dataset, config, training.default_device(), bar
+          robot, view, dataset, config, fitting.default_device(), bar
         )
       checkpoint.save_checkpoint(path, column.forward_model, key)
       snapshots.discard(partial)

@@ -6,6 +6,7 @@ from typing import Callable
 
 import torch
 
+from smpl import fitting
 from smpl import forward_model as smpl_forward
 from smpl import progressive
 from smpl import training
@@ -134,8 +135,8 @@ def train_inverse(
   and the training column's latest, weighted the same way.
   """
   _, inverse_config = training_configs(seed, profile, params)
-  device = training.default_device()
-  with training.seeded(seed, torch.device("cpu")):
+  device = fitting.default_device()
+  with fitting.seeded(seed, torch.device("cpu")):
     inverse = _inverse_model(views, per_module, make_model, params)
   action_sizes = [view.action_size for view in views]
   best_losses = []
@@ -179,10 +180,10 @@ def train_inverse(
 
 def _epoch_callback(
   bar, on_epoch: EpochCallback | None, first_epoch: int, loss_so_far: Callable[[float], float]
-) -> Callable[[training.EpochReport], None]:
-  """``smpl.training.fit``'s epoch callback: advances the progress bar, then calls ``on_epoch``."""
+) -> Callable[[fitting.EpochReport], None]:
+  """``smpl.fitting.fit``'s epoch callback: advances the progress bar, then calls ``on_epoch``."""
 
-  def epoch_end(report: training.EpochReport) -> None:
+  def epoch_end(report: fitting.EpochReport) -> None:
     if bar is not None:
       bar(report)
     if on_epoch is not None:

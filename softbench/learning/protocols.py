@@ -19,6 +19,7 @@ import dataclasses
 
 import torch
 
+from smpl import fitting
 from smpl import forward_model as smpl_forward
 from smpl import progressive
 from smpl import protocol as smpl_protocol
@@ -88,7 +89,7 @@ class PreparedColumn:
   robot: robots.SoftArm
   windows: data.SplitWindows
   forward_model: smpl_forward.ForwardModel
-  forward_training: training.TrainingResult
+  forward_training: fitting.TrainingResult
 
   @property
   def task(self) -> smpl_protocol.ColumnTask:
@@ -103,11 +104,11 @@ def prepare_column(
   dataset: data.Dataset,
   config: training.ForwardTrainingConfig = training.ForwardTrainingConfig(),
   device: torch.device | None = None,
-  on_epoch_end: Callable[[training.EpochReport], None] | None = None,
+  on_epoch_end: Callable[[fitting.EpochReport], None] | None = None,
 ) -> PreparedColumn:
   """Cuts ``view``'s windows from ``dataset`` and trains (then freezes) its forward model."""
   windows = data.windows(dataset, view)
-  with training.seeded(config.seed, torch.device("cpu")):
+  with fitting.seeded(config.seed, torch.device("cpu")):
     model = smpl_forward.ForwardModel(windows.train.actuation_size, windows.train.pose_size)
   result = training.train_forward_model(
     model, windows.train, windows.validation, config, device, on_epoch_end
@@ -173,13 +174,13 @@ def _train_jointly(
   stage_progress: smpl_protocol.StageProgress,
 ) -> smpl_protocol.ProgressiveRun:
   """Adds and trains one column per module, all columns acting together; scores after each."""
-  device = device if device is not None else training.default_device()
+  device = device if device is not None else fitting.default_device()
   outcome = smpl_protocol.ProgressiveRun(training=[], scores=[])
   for stage, column in enumerate(columns):
     seen = columns[: stage + 1]
     split = lambda name: smpl_windows.ModuleWindows(tuple(getattr(c.windows, name) for c in seen))
     train = column.windows.train
-    with training.seeded(config.seed + network.num_columns, torch.device("cpu")):
+    with fitting.seeded(config.seed + network.num_columns, torch.device("cpu")):
       network.add_column(
         smpl_windows.inverse_input_size(train.pose_size, train.action_size), train.action_size
       )
@@ -190,8 +191,8 @@ def _train_jointly(
           network, forwards, split("train"), split("validation"), config, device, on_epoch_end
         )
       )
-    test = split("test")  # Scored on the CPU, where the trained models are (training.on_device).
-    with torch.no_grad(), training.limited_cpu_threads(config.cpu_threads, torch.device("cpu")):
+    test = split("test")  # Scored on the CPU, where the trained models are (fitting.on_device).
+    with torch.no_grad(), fitting.limited_cpu_threads(config.cpu_threads, torch.device("cpu")):
       rollouts = smpl_rollout.joint_rollout(network.eval(), test, forwards)
     outcome.scores.append(
       [

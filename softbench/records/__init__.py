@@ -1,9 +1,9 @@
 """Result records: their JSON Schema, their integrity hash, and checked writing and reading.
 
-The package owns every record format and imports no torch: run records here, Exp1S records in
-``records.exp1s``, continual ones in ``records.continual``, the fields all share in
-``records.fields``, provenance in
-``records.provenance``. Runners write through ``write``; the leaderboard reads through ``read``.
+The package owns every record format and imports no torch and no MuJoCo: run records in
+``records.run``, Exp1S records in ``records.exp1s``, continual ones in ``records.continual``, the
+fields all share in ``records.fields``, provenance in ``records.provenance``. Runners write
+through ``write``; the leaderboard reads through ``read``.
 
 A record is one ``softbench run`` (format ``softbench-result``, version 2): provenance, settings
 and per-seed errors; or one ``softbench run --protocol exp1s`` (format
@@ -12,7 +12,7 @@ and per-seed errors; or one ``softbench run --protocol exp1s`` (format
 ``records.continual``). Reading and
 writing dispatch on ``format``. ``write`` seals a record with ``sha256``, the hash of the
 canonical JSON of everything else in it, and ``read`` refuses a file that is not valid JSON, does
-not match its kind's schema (``schema()``, ``records.exp1s.schema()``, JSON Schema draft
+not match its kind's schema (``records.run.schema()``, ``records.exp1s.schema()``, JSON Schema draft
 2020-12), holds a non-finite number, no longer matches its hash (a hand-edited number), or
 contradicts itself (seed count, module counts, the mean over modules). Every refusal is one line
 that names the file.
@@ -36,34 +36,21 @@ import stat
 import jsonschema
 from jsonschema import exceptions as schema_exceptions
 
-from softbench import robots
 from softbench import storage
-from softbench import suite
 from softbench.records import continual as continual_records
 from softbench.records import exp1s as exp1s_records
 from softbench.records import fields as record_fields
-from softbench.records.fields import METRICS
+from softbench.records import run as run_records
+from softbench.records.fields import METRICS  # noqa: F401  (records.METRICS)
+from softbench.records.run import ADAPTIVE_SECTION  # noqa: F401  (records.ADAPTIVE_SECTION)
+from softbench.records.run import FORMAT
+from softbench.records.run import VERSION
+from softbench.records.run import schema
 
 DEFAULT_FOLDER = pathlib.Path("leaderboard/results")  # The committed leaderboard's records
 # (a checkout's): what softbench leaderboard, sweep and zoo read by default.
 USER_FOLDER_NAME = "results"  # In the data home: where softbench run writes by default.
-FORMAT = "softbench-result"
-VERSION = 2
 INTEGRITY_FIELD = record_fields.INTEGRITY_FIELD
-"""Errors a record may hold per seed; position and normalised tip error always, orientation
-except for position-only tasks (reach)."""
-_OPTIONAL_FIELDS = (
-  "video",
-  "faults",
-  "zoo",
-  "training",
-  "helpers",
-  "given",
-  record_fields.WEIGHTS_FIELD,
-  *record_fields.OPTIONAL_FIELDS,
-)
-ADAPTIVE_SECTION = "adaptive"  # softbench run --adaptive: per-target results, no per-seed ones.
-_MEAN_TOLERANCE = 1e-9  # Relative: a seed's mean against the mean of its per-module values.
 MAX_SAME_NAME = 1000  # Records of one setting and second that ``write_new`` names apart.
 _MAX_MESSAGE_CHARS = 160  # Of a schema error's message, so that a refusal stays one line.
 
@@ -79,107 +66,6 @@ class RecordError(ValueError):
   """A result record that cannot be used; the message names the file."""
 
 
-def schema() -> dict:
-  """The JSON Schema (draft 2020-12) of a ``softbench run`` record, enums from the current
-  registries."""
-  non_negative = record_fields.non_negative()
-  per_module = {"type": "array", "items": non_negative, "minItems": 1}
-  metric = {
-    "type": "object",
-    "additionalProperties": False,
-    "required": ["per_module", "per_module_std_over_steps", "mean"],
-    "properties": {
-      "per_module": per_module,
-      "per_module_std_over_steps": per_module,
-      "mean": non_negative,
-    },
-  }
-  section = record_fields.section()
-  seed = {
-    "type": "object",
-    "required": ["seed", "steps", "mean_reward", "position_mm", "normalised_tip_percent"],
-    "properties": {
-      "seed": {"type": "integer", "minimum": 0},
-      "steps": {"type": "integer", "minimum": 1},
-      "mean_reward": {"type": "number", "minimum": 0, "maximum": 1},
-      **{name: metric for name in METRICS},
-    },
-    "additionalProperties": section,
-  }
-  properties = {
-    "format": {"const": FORMAT},
-    "version": {"const": VERSION},
-    "robot": {"type": "string", "pattern": record_fields.ROBOT_PATTERN},
-    "task": {"enum": list(suite.TASKS)},
-    "eval_mode": {"enum": list(record_fields.ERROR_SOURCES)},
-    "trajectory": {"type": ["string", "null"]},
-    "given": {"type": "string", "minLength": 1},  # A custom trajectory's given part (Given.text).
-    # How a learned agent completed partial targets (softbench.agents.fields.HELPER_TARGETS);
-    # records before target completion (2026-12-03) held every module not given ("hold").
-    "helpers": {"enum": list(record_fields.HELPER_TARGETS)},
-    "scored_modules": {
-      "type": "array",
-      "items": {"type": "integer", "minimum": 1},
-      "minItems": 1,
-      "uniqueItems": True,
-    },
-    "per_seed": {"type": "array", "items": seed},  # Empty in adaptive activation records.
-    "video": {"type": "string", "minLength": 1},
-    "faults": {
-      "type": "array",
-      "items": {  # softbench.robots.faults.describe
-        "type": "object",
-        "required": ["module", "actuator", "gain", "text"],
-        "properties": {
-          "module": {"type": "integer", "minimum": 1},
-          "actuator": {"type": "integer", "minimum": 0},
-          "gain": {"type": "number", "minimum": 0, "maximum": 1},
-          "text": {"type": "string"},
-        },
-      },
-    },
-    # The zoo files a run took instead of training (softbench.zoo.section).
-    "zoo": {
-      "type": "object",
-      "required": ["files"],
-      "properties": {
-        "files": {"type": "array", "items": {"type": "string", "minLength": 1}, "minItems": 1}
-      },
-    },
-    # The files each seed's agent was made of, with their sha256 (softbench.zoo.weights_section).
-    record_fields.WEIGHTS_FIELD: record_fields.weights(),
-    # What an agent that learns by acting spent per seed (softbench.agents.training_summary).
-    "training": {
-      "type": "object",
-      "required": ["per_seed"],
-      "properties": {
-        "per_seed": {
-          "type": "array",
-          "items": {
-            "type": "object",
-            "required": ["seed"],
-            "properties": {
-              "seed": {"type": "integer", "minimum": 0},
-              "environment_steps": {"type": "integer", "minimum": 1},
-              "episodes": {"type": "integer", "minimum": 1},
-              "wall_time_s": record_fields.non_negative(record_fields.MAX_WALL_TIME_S),
-            },
-          },
-        }
-      },
-    },
-    **record_fields.properties(),
-  }
-  return {
-    "$schema": "https://json-schema.org/draft/2020-12/schema",
-    "title": "softbench result record",
-    "type": "object",
-    "required": [name for name in properties if name not in _OPTIONAL_FIELDS],
-    "properties": properties,
-    "additionalProperties": section,
-  }
-
-
 @dataclasses.dataclass(frozen=True)
 class Kind:
   """One kind of record: the version this softbench reads, its schema and its own checks."""
@@ -193,7 +79,7 @@ class Kind:
 def kinds() -> dict[str, Kind]:
   """Every kind of record, by format."""
   return {
-    FORMAT: Kind(FORMAT, VERSION, schema, _check_consistency),
+    FORMAT: Kind(FORMAT, VERSION, schema, run_records.check),
     exp1s_records.FORMAT: Kind(
       exp1s_records.FORMAT, exp1s_records.VERSION, exp1s_records.schema, exp1s_records.check
     ),
@@ -408,47 +294,3 @@ def check_finite(value: object, source: str, path: tuple = ()) -> None:
   elif isinstance(value, list):
     for index, item in enumerate(value):
       check_finite(item, source, path + (index,))
-
-
-def _check_consistency(record: dict, refuse: record_fields.Refuse) -> None:
-  """What the schema cannot say of a run record: counts that must agree, means that must
-  follow."""
-  adaptive = ADAPTIVE_SECTION in record
-  if adaptive and record["per_seed"]:
-    refuse(f"an {ADAPTIVE_SECTION} record holds its scores in that section; per_seed must be empty")
-  record_fields.check(record, refuse, seed_entries=0 if adaptive else None)
-  per_seed = record["per_seed"]
-  try:
-    num_modules = robots.num_modules(record["robot"])
-  except ValueError as error:
-    refuse(f"robot: {error}")
-  if max(record["scored_modules"]) > num_modules:
-    refuse(
-      f"scored_modules {record['scored_modules']} name a module beyond {record['robot']}'s "
-      f"{num_modules}"
-    )
-  if (record["trajectory"] is None) == (record["task"] == "custom"):
-    refuse("trajectory goes with task custom, and task custom needs one")
-  measured = [name for name in METRICS if per_seed and name in per_seed[0]]
-  for index, entry in enumerate(per_seed):
-    if [name for name in METRICS if name in entry] != measured:
-      refuse(
-        f"per_seed[{index}] has metrics {[n for n in METRICS if n in entry]}, per_seed[0] "
-        f"has {measured}"
-      )
-    for name in measured:
-      where = f"per_seed[{index}].{name}"
-      for field in ("per_module", "per_module_std_over_steps"):
-        if len(entry[name][field]) != len(record["scored_modules"]):
-          refuse(
-            f"{where}.{field} has {len(entry[name][field])} values for "
-            f"{len(record['scored_modules'])} scored modules"
-          )
-      expected = math.fsum(entry[name]["per_module"]) / len(entry[name]["per_module"])
-      if not math.isclose(
-        entry[name]["mean"], expected, rel_tol=_MEAN_TOLERANCE, abs_tol=_MEAN_TOLERANCE
-      ):
-        refuse(
-          f"{where}.mean {entry[name]['mean']} is not the mean of its per_module values "
-          f"({expected})"
-        )

@@ -12,6 +12,8 @@ records.
 
 import math
 
+import numpy as np
+
 from softbench import metrics
 from softbench import robots
 from softbench.records import fields as record_fields
@@ -153,3 +155,21 @@ def _check_triangular(matrix: list, size: int, where: str, refuse: record_fields
           f"{where}[{stage}][{configuration}] is {value}; {expected} expected "
           f"(null exactly above the diagonal)"
         )
+
+
+def family(record: dict) -> str:
+  """The tendon family of an Exp1S record's configurations."""
+  return robots.family_of(record["robots"][0]).name
+
+
+def mean_forgetting(record: dict) -> np.ndarray:
+  """The physics forgetting matrix (stages x configurations, normalised tip error in %), mean
+  over seeds; NaN for configurations not yet seen."""
+  matrices = [
+    [
+      [np.nan if value is None else value for value in row]
+      for row in seed["forgetting_tip_percent"]
+    ]
+    for seed in record["per_seed"]
+  ]
+  return np.mean(np.array(matrices, dtype=float), axis=0)

@@ -25,13 +25,12 @@ import time
 
 import numpy as np
 
+from smpl import fitting
 from smpl import progressive
-from smpl import training
 from softbench import data
 from softbench import episodes
 from softbench import metrics
 from softbench import profiles
-from softbench import robots
 from softbench import suite
 from softbench import zoo
 from softbench.agents import hyperparameters
@@ -40,6 +39,7 @@ from softbench.data import dataset
 from softbench.episodes import snapshots as episode_snapshots
 from softbench.learning import exp1s as exp1s_training
 from softbench.learning import inverse as inverse_training
+from softbench.records import exp1s as exp1s_records
 from softbench.records import provenance
 from softbench.records.exp1s import DEFAULT_FAMILY
 from softbench.records.exp1s import FORGETTING_TASK
@@ -310,7 +310,7 @@ def execute(
   discards them, ``episode_snapshots.discard_folder(finished_seeds_folder(profile, family))``,
   once the record is safely written)."""
   started = time.perf_counter()
-  origin = provenance.provenance(str(training.default_device()))
+  origin = provenance.provenance(str(fitting.default_device()))
   seeds = seed_count(profile, seeds)
   sequence = exp1s_training.protocol(family)
   taken, trained = zoo.take([checkpoint_path(seed, profile, family) for seed in range(seeds)])
@@ -355,19 +355,6 @@ def assemble_record(
     ),
     "wall_time_s": round(wall_time_s, 3),
   }
-
-
-def mean_forgetting(record: dict) -> np.ndarray:
-  """The physics forgetting matrix (stages x configurations, normalised tip error in %), mean
-  over seeds; NaN for configurations not yet seen."""
-  matrices = [
-    [
-      [np.nan if value is None else value for value in row]
-      for row in seed["forgetting_tip_percent"]
-    ]
-    for seed in record["per_seed"]
-  ]
-  return np.mean(np.array(matrices, dtype=float), axis=0)
 
 
 def _statistic(values: list[float]) -> str:
@@ -421,23 +408,18 @@ def table(record: dict) -> str:
   return "\n".join(lines)
 
 
-def family_of(record: dict) -> str:
-  """The tendon family of an Exp1S record's configurations."""
-  return robots.family_of(record["robots"][0]).name
-
-
 def finish(record: dict, files: list[pathlib.Path]) -> None:
   """What follows a saved record (``files``, the results folder's first): the finished seeds
   kept for resuming go (only now: a failed write leaves a run that resumes), then the heat map
   of forgetting beside the record."""
   from softbench import plots  # Not at the top: as in run.finish, no seed worker needs it.
 
-  profile, family = profiles.get(record["profile"]), family_of(record)
+  profile, family = profiles.get(record["profile"]), exp1s_records.family(record)
   episode_snapshots.discard_folder(finished_seeds_folder(profile, family))
   path = files[0]
-  heat_map = plots.forgetting_matrix(
-    mean_forgetting(record), record["robots"], path.with_name(f"{path.stem}-forgetting.png")
-  )
+  heat_map_path = path.with_name(f"{path.stem}-forgetting.png")
+  matrix = exp1s_records.mean_forgetting(record)
+  heat_map = plots.forgetting_matrix(matrix, record["robots"], heat_map_path)
   print(f"plot: {heat_map}")
 
 
@@ -451,5 +433,5 @@ def run_name(profile_name: str, family: str) -> str:
 
 def record_path(record: dict, results: pathlib.Path) -> pathlib.Path:
   """``run_name``, then the record's date: ``smpl-exp1s-[FAMILY-]PROFILE-DATE.json``."""
-  name = run_name(record["profile"], family_of(record))
+  name = run_name(record["profile"], exp1s_records.family(record))
   return results / f"{name}-{provenance.date_stamp(record)}.json"

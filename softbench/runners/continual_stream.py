@@ -18,7 +18,7 @@ from typing import Sequence
 
 import numpy as np
 
-from smpl import training
+from smpl import fitting
 from softbench import data
 from softbench import metrics
 from softbench import profiles
@@ -151,7 +151,7 @@ def execute(
   episodes are discarded at the end unless ``keep_seeds`` (then ``finish`` discards them once
   the record is written)."""
   started = time.perf_counter()
-  origin = provenance.provenance(str(training.default_device()))
+  origin = provenance.provenance(str(fitting.default_device()))
   configurations = streams.get(run.stream).configurations(run.family)
   for configuration in configurations:  # Every core, before the seeds.
     data.collect(

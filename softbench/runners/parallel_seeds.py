@@ -12,7 +12,7 @@ import threading
 
 import torch
 
-from smpl import training
+from smpl import fitting
 from softbench import progress as progress_bars
 from softbench import terminal
 from softbench.data import dataset
@@ -27,7 +27,7 @@ def _init_worker(states) -> None:
   with the cores busy); Ctrl-C reaches the parent only, which stops the workers itself, and the
   worker ends with its parent (``_exit_with_parent``); warnings print as in the parent; progress
   bars send their states to the parent's ``states`` queue."""
-  torch.set_num_threads(training.CPU_THREADS)
+  torch.set_num_threads(fitting.CPU_THREADS)
   signal.signal(signal.SIGINT, signal.SIG_IGN)
   _exit_with_parent()
   terminal.one_line_warnings()
@@ -153,7 +153,7 @@ def over_seeds(
 ) -> list:
   """``function(seed, *arguments, show)`` for seeds 0..seeds-1, in ``workers`` processes (default:
   one per core), never more than there are seeds; each seed computes with
-  ``smpl.training.CPU_THREADS`` torch threads, in this process or a worker."""
+  ``smpl.fitting.CPU_THREADS`` torch threads, in this process or a worker."""
   if workers is not None:
     dataset.check_count("workers", workers)
   workers = min(seeds, workers or os.cpu_count() or 1)
@@ -161,5 +161,5 @@ def over_seeds(
     return in_processes(
       function, [(seed, *arguments, False) for seed in range(seeds)], f"{label}: seeds", workers
     )
-  with training.limited_cpu_threads(training.CPU_THREADS, torch.device("cpu")):
+  with fitting.limited_cpu_threads(fitting.CPU_THREADS, torch.device("cpu")):
     return [function(seed, *arguments, show_progress) for seed in range(seeds)]

@@ -20,7 +20,7 @@ import dataclasses
 import pathlib
 import time
 
-from smpl import training
+from smpl import fitting
 from softbench import agents
 from softbench import data
 from softbench import metrics
@@ -145,7 +145,7 @@ def execute(settings: RetrainSettings, show_progress: bool = True) -> dict:
   """Collects both robots' babbling, runs every seed (one after the other) and returns the
   result record."""
   started = time.perf_counter()
-  origin = provenance.provenance(str(training.default_device()))
+  origin = provenance.provenance(str(fitting.default_device()))
   run = settings.run
   healthy = robots.make(run.robot)
   faulty = healthy.with_faults(run.faults)

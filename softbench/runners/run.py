@@ -17,7 +17,7 @@ import dataclasses
 import pathlib
 import time
 
-from smpl import training
+from smpl import fitting
 from softbench import agents
 from softbench import data
 from softbench import episodes
@@ -276,7 +276,7 @@ def execute_episodes(
   kept for resuming are discarded at the end unless ``keep_seeds``: then the caller discards
   them (``episode_snapshots.discard``) once the record is safely written."""
   started = time.perf_counter()
-  origin = provenance.provenance(str(training.default_device()))
+  origin = provenance.provenance(str(fitting.default_device()))
   taken, trained = take_from_zoo(run)
   learns = agents.learner(run.agent) is not None or agents.describe(run.agent).learned
   if learns and not trained:  # Some seed trains on babbling (or acts towards its targets, sac).

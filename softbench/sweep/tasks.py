@@ -1,7 +1,7 @@
 """What a sweep's Ray tasks run in their worker processes: builds, evaluations and a node's facts.
 
 Each task first sets its process up as ``softbench run``'s seed workers are (one torch thread,
-``smpl.training.CPU_THREADS``; one-line warnings; its bars relayed to the sweep's display) and
+``smpl.fitting.CPU_THREADS``; one-line warnings; its bars relayed to the sweep's display) and
 writes the cache files of the builds it is given that its data home lacks (``shipping``). A build
 then finds or makes its cached files and returns them; an evaluation returns its seed's record
 entry and episode (``run.fresh_seed``), an Exp1S seed's scores (``continual.run_seed``) or a
@@ -14,7 +14,7 @@ import contextlib
 import ray
 import torch
 
-from smpl import training
+from smpl import fitting
 from softbench import agents
 from softbench import data
 from softbench import progress
@@ -37,7 +37,7 @@ def _relayed(states: relay.Relay | None) -> Iterator[None]:
   Ctrl-C, which the driver handles by cancelling: one torch thread, one-line warnings, and the
   task's bars relayed to the driver's ``states`` (None where the sweep shows no progress), all
   sent by the end of the block."""
-  torch.set_num_threads(training.CPU_THREADS)
+  torch.set_num_threads(fitting.CPU_THREADS)
   terminal.one_line_warnings()
   progress.relay_to(states)
   try:
@@ -118,4 +118,4 @@ def evaluate(
 
 def node_facts() -> tuple[str, str]:
   """The hash of this node's softbench and smpl source, and the device its agents train on."""
-  return episode_snapshots.source_sha256(), str(training.default_device())
+  return episode_snapshots.source_sha256(), str(fitting.default_device())

@@ -12,12 +12,12 @@ import pytest
 import torch
 
 import smpl
+from smpl.fitting import CPU_THREADS
+from smpl.fitting import limited_cpu_threads
 from smpl.forward_model import ForwardModel
 from smpl.inverse import InverseModel
-from smpl.training import CPU_THREADS
 from smpl.training import INVERSE_BATCH_SIZE
 from smpl.training import ForwardTrainingConfig
-from smpl.training import limited_cpu_threads
 from smpl.training import train_forward_model
 from smpl.windows import SEQUENCE_LENGTH
 from smpl.windows import BabblingWindows
@@ -30,7 +30,7 @@ SHORT_WINDOW = 2  # Control steps per window of the compile tests' data.
 
 @pytest.fixture(scope="session", autouse=True)
 def _few_cpu_threads() -> Iterator[None]:
-  """Runs these tiny models on the thread count training uses (see smpl.training.CPU_THREADS)."""
+  """Runs these tiny models on the thread count training uses (see smpl.fitting.CPU_THREADS)."""
   with limited_cpu_threads(CPU_THREADS, torch.device("cpu")):
     yield
 

@@ -1,7 +1,7 @@
 import torch
 
+from smpl.fitting import evaluate_loss
 from smpl.forward_model import ForwardModel
-from smpl.training import evaluate_loss
 from smpl.training import forward_model_loss
 from smpl.windows import BabblingWindows
 

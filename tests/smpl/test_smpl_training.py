@@ -6,19 +6,20 @@ import warnings
 import pytest
 import torch
 
+from smpl import fitting
 from smpl import training
 from smpl.baselines import BiLSTMInverse
 from smpl.baselines import LSTMInverse
 from smpl.baselines import MLPInverse
 from smpl.baselines import VAELSTMInverse
+from smpl.fitting import EarlyStopping
+from smpl.fitting import evaluate_loss
+from smpl.fitting import fit
 from smpl.forward_model import ForwardModel
 from smpl.progressive import ProgressiveColumn
 from smpl.progressive import ProgressiveLSTM
-from smpl.training import EarlyStopping
 from smpl.training import ForwardTrainingConfig
 from smpl.training import InverseTrainingConfig
-from smpl.training import evaluate_loss
-from smpl.training import fit
 from smpl.training import forward_model_loss
 from smpl.training import inverse_model_loss
 from smpl.training import train_forward_model
@@ -213,7 +214,7 @@ def test_a_compiled_optimiser_step_prints_no_profiler_notice() -> None:
     model = torch.nn.Linear(3, 1)
     optimizer = torch.optim.Adam(model.parameters())
     model(torch.ones(3)).sum().backward()
-    training._compiled(optimizer.step)()
+    fitting._compiled(optimizer.step)()
   finally:
     logger.removeHandler(handler)
   assert "Profiler record function" not in said.getvalue()
@@ -237,13 +238,13 @@ def test_every_trainable_inverse_model_is_listed(inverse_model_classes: set[type
 @pytest.fixture
 def compiled_functions(monkeypatch) -> list:
   """What `smpl.training` hands to torch.compile during the test (still compiled)."""
-  handed, compiled = [], training._compiled
+  handed, compiled = [], fitting._compiled
 
   def counting(function):
     handed.append(function)
     return compiled(function)
 
-  monkeypatch.setattr(training, "_compiled", counting)
+  monkeypatch.setattr(fitting, "_compiled", counting)
   return handed
 
 
@@ -337,7 +338,7 @@ def _zero_action_loss(windows: BabblingWindows) -> float:
 def test_a_training_that_does_not_diverge_is_untouched_by_restarts(
   arm_data: dict[str, BabblingWindows], trained_forward_model: ForwardModel
 ) -> None:
-  def train(restart_diverged: bool) -> tuple[dict[str, torch.Tensor], training.TrainingResult]:
+  def train(restart_diverged: bool) -> tuple[dict[str, torch.Tensor], fitting.TrainingResult]:
     network = _fresh_column()
     result = train_inverse_model(
       network,
@@ -373,11 +374,11 @@ def test_a_diverged_training_starts_again_from_its_initial_weights_at_half_the_r
         parameter.add_(1.0)
     loss = 3 * zero_action if len(calls) < 3 else zero_action / 10
     blown_up = 100 * zero_action if len(calls) < 3 else loss
-    return training.TrainingResult(
-      0, loss, True, [training.EpochReport(0, blown_up, loss, loss, True, 0.1)]
+    return fitting.TrainingResult(
+      0, loss, True, [fitting.EpochReport(0, blown_up, loss, loss, True, 0.1)]
     )
 
-  monkeypatch.setattr(training, "fit", diverging_then_converging)
+  monkeypatch.setattr(fitting, "fit", diverging_then_converging)
   with pytest.warns(UserWarning, match="training of seed 0 diverged") as caught:
     result = train_inverse_model(
       network,
@@ -431,14 +432,14 @@ def test_a_short_training_that_has_not_learned_yet_is_not_diverged(
 
   def barely_trained(model, batch_loss, train, validation, config, *args, **kwargs):
     calls.append(config.learning_rate)
-    return training.TrainingResult(
+    return fitting.TrainingResult(
       0,
       1.1 * zero_action,
       False,
-      [training.EpochReport(0, 1.5 * zero_action, 1.1 * zero_action, 1.1 * zero_action, True, 0.1)],
+      [fitting.EpochReport(0, 1.5 * zero_action, 1.1 * zero_action, 1.1 * zero_action, True, 0.1)],
     )
 
-  monkeypatch.setattr(training, "fit", barely_trained)
+  monkeypatch.setattr(fitting, "fit", barely_trained)
   with warnings.catch_warnings():
     warnings.simplefilter("error")
     result = train_inverse_model(

@@ -4,6 +4,7 @@ import pytest
 import torch
 
 from smpl import files
+from smpl import fitting
 from smpl import snapshots
 from smpl import training
 from smpl.baselines import VAELSTMInverse
@@ -34,7 +35,7 @@ TRAIN, VALIDATION = windows(64, 1), windows(16, 2)
 
 
 def forward_model():
-  with training.seeded(0, CPU):
+  with fitting.seeded(0, CPU):
     return ForwardModel(ACTION, POSE)
 
 
@@ -56,7 +57,7 @@ def train_vae(model, on_epoch_end=None, config=INVERSE):
 
 
 def vae():
-  with training.seeded(0, CPU):
+  with fitting.seeded(0, CPU):
     return VAELSTMInverse(inverse_input_size(POSE, ACTION), ACTION)
 
 
@@ -110,7 +111,7 @@ def test_finished_fit_returns_its_result_without_training(tmp_path, monkeypatch)
   with snapshots.resumable(tmp_path):
     first = forward_model()
     expected = train_forward(first)
-  monkeypatch.setattr(training, "_train_epoch", lambda *args: pytest.fail("trained again"))
+  monkeypatch.setattr(fitting, "_train_epoch", lambda *args: pytest.fail("trained again"))
   snapshot = tmp_path / "fit-1.pt"
   written = snapshot.stat().st_mtime_ns
   again = forward_model()

@@ -21,6 +21,7 @@ from typing import ClassVar
 import torch
 from torch import nn
 
+from smpl import fitting
 from smpl import forward_model as smpl_forward
 from smpl import training
 from smpl.inverse import InverseModel
@@ -66,7 +67,7 @@ class StageTraining:
   """What one stage's training did: the fits it ran (none for a strategy that learned everything
   earlier) and the configurations whose data it read."""
 
-  results: tuple[training.TrainingResult, ...]
+  results: tuple[fitting.TrainingResult, ...]
   trained_on: tuple[int, ...]
 
 
@@ -98,7 +99,7 @@ class Strategy(abc.ABC):
   @abc.abstractmethod
   def learn(self, stage: int, stages: list[StageData], on_epoch_end) -> StageTraining:
     """Learns stage ``stage`` from ``stages`` (0..stage, or every stage for a strategy that is
-    not ``continual``); ``on_epoch_end`` gets each epoch's ``smpl.training.EpochReport``."""
+    not ``continual``); ``on_epoch_end`` gets each epoch's ``smpl.fitting.EpochReport``."""
 
   @abc.abstractmethod
   def controller(self, configuration: int) -> InverseModel:
@@ -112,7 +113,7 @@ class Strategy(abc.ABC):
   def new_seeded(self, offset: int, build):
     """``build()`` with torch seeded by the run's seed plus ``offset`` (a new network's initial
     weights)."""
-    with training.seeded(self.setting.seed + offset, torch.device("cpu")):
+    with fitting.seeded(self.setting.seed + offset, torch.device("cpu")):
       return build()
 
 
@@ -123,7 +124,7 @@ def fit_configuration(
   on_epoch_end,
   penalty=None,
   forwards: tuple[smpl_forward.ForwardModel, ...] = (),
-) -> training.TrainingResult:
+) -> fitting.TrainingResult:
   """Trains ``model`` in closed loop on ``stage``'s windows through its forward model, as
   ``smpl.training.train_inverse_model`` does, plus ``penalty()`` (a scalar tensor: EWC's
   consolidation, a replay batch's loss) on every training batch; validation is ``stage``'s
@@ -139,8 +140,8 @@ def fit_configuration(
   def loss(windows):
     return action_loss(windows) + (penalty() if penalty is not None else 0.0)
 
-  with training.on_device(setting.device, stage.forward, *forwards):
-    return training.fit(
+  with fitting.on_device(setting.device, stage.forward, *forwards):
+    return fitting.fit(
       model,
       loss,
       stage.windows.train,

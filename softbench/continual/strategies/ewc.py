@@ -11,6 +11,7 @@ the closed-loop action MSE."""
 import torch
 from torch import nn
 
+from smpl import fitting
 from smpl import training
 from softbench.continual.strategies import base
 from softbench.continual.strategies import finetune
@@ -72,7 +73,7 @@ class ElasticWeightConsolidation(finetune.Finetune):
     config = self.setting.config
     windows = data.windows.train
     batches = torch.arange(len(windows)).split(config.batch_size)
-    with training.limited_cpu_threads(config.cpu_threads, torch.device("cpu")):
+    with fitting.limited_cpu_threads(config.cpu_threads, torch.device("cpu")):
       for indices in batches:
         model.zero_grad(set_to_none=True)
         training.inverse_model_loss(

@@ -7,6 +7,7 @@ train nothing."""
 
 import torch
 
+from smpl import fitting
 from smpl import training
 from smpl import windows as smpl_windows
 from softbench.continual.strategies import base
@@ -32,8 +33,8 @@ class Joint(shared.SharedNetwork):
       return sum(losses[1:], losses[0]) / len(losses)
 
     forwards = [data.forward for data in stages]
-    with training.on_device(self.setting.device, *forwards):
-      result = training.fit(
+    with fitting.on_device(self.setting.device, *forwards):
+      result = fitting.fit(
         self.module.network,
         loss,
         _aligned([data.windows.train for data in stages]),

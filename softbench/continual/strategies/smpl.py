@@ -4,6 +4,7 @@ frozen (``smpl.protocol.train_next_column``); configuration c acts with column c
 
 import torch
 
+from smpl import fitting
 from smpl import progressive
 from smpl import training
 from smpl import windows as smpl_windows
@@ -19,7 +20,7 @@ class Progressive(base.Strategy):
     # train_next_column seeds column k with the seed plus k; a cached state loads into it.
     network = self.module.network
     size = self.setting.action_sizes[stage]
-    with training.seeded(self.setting.seed + network.num_columns, torch.device("cpu")):
+    with fitting.seeded(self.setting.seed + network.num_columns, torch.device("cpu")):
       network.add_column(smpl_windows.inverse_input_size(self.setting.pose_size, size), size)
 
   def learn(self, stage, stages, on_epoch_end) -> base.StageTraining:
