@@ -106,6 +106,10 @@ def test_registration_is_undone_between_tests():
       "unknown robot",
     ),
     (lambda: suite.register("new", ("build", (), "", "tendon-3", None)), "a TaskEntry"),
+    (
+      lambda: suite.register("new", dataclasses.replace(suite.describe("reach"), build="reach")),
+      "paths are module:name",
+    ),
     (lambda: suite.tracking_task("no default")(lambda length, laps: length), "needs a default"),
     (lambda: suite.tracking_task("robot first", planar=False)(lambda length: 0), "must take"),
     (
@@ -117,6 +121,15 @@ def test_registration_is_undone_between_tests():
 def test_a_bad_registration_is_refused_with_one_line(register, message, restored_registries):
   with pytest.raises(ValueError, match=message) as error:
     register()
+  assert "\n" not in str(error.value)
+
+
+def test_a_builder_path_that_names_nothing_is_one_line_when_the_task_is_built(restored_registries):
+  # A path is imported only when the task is built, so registering it loads nothing.
+  entry = dataclasses.replace(suite.describe("reach"), build="softbench.suite.nowhere:Reach")
+  suite.register("nowhere", entry)
+  with pytest.raises(ValueError, match="cannot be imported") as error:
+    suite.load("tendon-1", "nowhere")
   assert "\n" not in str(error.value)
 
 

@@ -69,11 +69,18 @@ class TaskEntry:
 
 
 def _resolved(target: Callable | str) -> Callable:
-  """``target``, or the object that its path ``module:name`` names."""
+  """``target``, or the object that its path ``module:name`` names.
+
+  Raises:
+    ValueError: the path names nothing that can be imported (one line).
+  """
   if callable(target):
     return target
   module, _, name = target.partition(":")
-  return getattr(importlib.import_module(module), name)
+  try:
+    return getattr(importlib.import_module(module), name)
+  except (ImportError, AttributeError) as error:
+    raise ValueError(f"{target!r} cannot be imported ({type(error).__name__}: {error})") from None
 
 
 _TASKS: dict[str, TaskEntry] = {}
