@@ -189,6 +189,27 @@ def test_reading_every_record_loads_no_engine():
   assert result.stdout.strip() == "[]"
 
 
+def test_the_lazily_loaded_packages_still_give_their_modules_and_names():
+  # robots, suite and data load their engine-bound parts on first use: what they gave as
+  # attributes when they imported them at once, they give still (in a fresh process, where no
+  # other import has loaded the modules before).
+  code = (
+    "from softbench import data, robots, suite\n"
+    "print(robots.tendon.BACKBONES, robots.TendonArm.__name__, suite.tracking.Tracking.__name__,"
+    " suite.load.__name__, data.dataset.Dataset.__name__, data.rng.__name__)"
+  )
+  result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+  assert result.stdout.split() == [
+    "('rod',",
+    "'cable')",
+    "TendonArm",
+    "Tracking",
+    "load",
+    "Dataset",
+    "rng",
+  ]
+
+
 # Every module at softbench's top level, and why it is not in a package: a new one says why here.
 TOP_LEVEL_MODULES = {
   "__init__": "the package: loads triton before EGL",

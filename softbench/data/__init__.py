@@ -17,6 +17,7 @@ import lazy_loader
 
 __getattr__, __dir__, __all__ = lazy_loader.attach(
   __name__,
+  submodules=["babbling", "chunks", "dataset", "normalisation", "seeding", "splits", "views"],
   submod_attrs={
     "babbling": ["CHUNK_LENGTH", "babbling_actions", "collect"],
     "dataset": [

@@ -26,9 +26,11 @@ from softbench.robots.catalogue import is_tendon
 from softbench.robots.catalogue import length
 from softbench.robots.catalogue import num_modules
 
-# The arm classes load MuJoCo: each is imported from its module on first use (``lazy_loader``).
+# The arm classes and the modules that build arms load MuJoCo: each is imported on first use
+# (``lazy_loader``), ``robots.tendon`` as ``robots.TendonArm``.
 __getattr__, __dir__, _ARM_CLASSES = lazy_loader.attach(
   __name__,
+  submodules=["base", "chain", "faults", "payload", "pneumatic", "tendon", "tendon_local"],
   submod_attrs={
     "base": ["SoftArm"],
     "tendon": ["CableDrivenArm", "TendonArm"],

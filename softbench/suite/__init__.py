@@ -61,7 +61,9 @@ _LISTS = {
   "BENCHMARKING": lambda: registry.pairs("benchmarking"),
 }
 _load_on_use, __dir__, _LOADED_ON_USE = lazy_loader.attach(
-  __name__, submod_attrs={"loading": ["build_task", "gives_whole_targets", "load"]}
+  __name__,
+  submodules=["base", "loading", "reach", "references", "tracking", "trajectories"],
+  submod_attrs={"loading": ["build_task", "gives_whole_targets", "load"]},
 )
 
 
