@@ -418,4 +418,8 @@ TABLES: dict[str, Callable[[ranking.Leaderboard], Table]] = {
   # A stream's table joins once its records are in (every named table appears in the docs).
   "continual-grow-tendon-default": continual_table("grow", "tendon", "default"),
   "continual-grow-tendon-default-diagonal": continual_table("grow", "tendon", "default", True),
+  "continual-payload-tendon-default": continual_table("payload", "tendon", "default"),
+  "continual-payload-tendon-default-diagonal": continual_table(
+    "payload", "tendon", "default", True
+  ),
 }
