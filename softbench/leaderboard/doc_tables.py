@@ -422,4 +422,8 @@ TABLES: dict[str, Callable[[ranking.Leaderboard], Table]] = {
   "continual-payload-tendon-default-diagonal": continual_table(
     "payload", "tendon", "default", True
   ),
+  "continual-degrade-tendon-default": continual_table("degrade", "tendon", "default"),
+  "continual-degrade-tendon-default-diagonal": continual_table(
+    "degrade", "tendon", "default", True
+  ),
 }
