@@ -23,12 +23,13 @@ from softbench.robots.catalogue import checked_family
 from softbench.robots.catalogue import family_named
 from softbench.robots.catalogue import family_of
 from softbench.robots.catalogue import is_tendon
+from softbench.robots.catalogue import known_family
 from softbench.robots.catalogue import length
 from softbench.robots.catalogue import num_modules
 
 # The arm classes and the modules that build arms load MuJoCo: each is imported on first use
 # (``lazy_loader``), ``robots.tendon`` as ``robots.TendonArm``.
-__getattr__, __dir__, _ARM_CLASSES = lazy_loader.attach(
+__getattr__, __dir__, _LOADED_ON_USE = lazy_loader.attach(
   __name__,
   submodules=["base", "chain", "faults", "payload", "pneumatic", "tendon", "tendon_local"],
   submod_attrs={
@@ -46,7 +47,7 @@ def make(name: str, **overrides):
   Raises:
     ValueError: unknown or malformed name, or an invalid field value (one line).
   """
-  family = checked_family(name)
+  family = known_family(name)  # The arm class parses the name (from_name) after the overrides.
   arm = family.arm
   fields = {field.name for field in dataclasses.fields(arm)}
   unknown = sorted(set(overrides) - fields)
@@ -57,7 +58,7 @@ def make(name: str, **overrides):
   return arm(**overrides)
 
 
-__all__ = _ARM_CLASSES + [
+__all__ = _LOADED_ON_USE + [
   "BENCHMARK_MODULES",
   "FAMILIES",
   "LEADERBOARD_ROBOTS",
@@ -75,6 +76,7 @@ __all__ = _ARM_CLASSES + [
   "family_named",
   "family_of",
   "is_tendon",
+  "known_family",
   "length",
   "make",
   "num_modules",

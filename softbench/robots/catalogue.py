@@ -137,11 +137,11 @@ def family_named(family_name: str) -> Family:
   return {family.name: family for family in FAMILIES}[family_name]
 
 
-def checked_family(name: object) -> Family:
-  """The family of robot ``name``, whose name it checks as ``softbench.robots.make`` does.
+def known_family(name: object) -> Family:
+  """The family that answers robot name ``name``, whose form it does not check yet.
 
   Raises:
-    ValueError: not a string, an unknown family, or a malformed name (one line).
+    ValueError: not a string, or no family answers it (one line).
   """
   if not isinstance(name, str):
     raise ValueError(f"robot name must be a string, got {name!r}")
@@ -151,6 +151,16 @@ def checked_family(name: object) -> Family:
       f"unknown robot {name!r}; choose "
       f"{' or '.join(family.usage for family in FAMILIES)} (N = 1 to {MAX_MODULES})"
     )
+  return family
+
+
+def checked_family(name: object) -> Family:
+  """The family of robot ``name``, whose name it checks as ``softbench.robots.make`` does.
+
+  Raises:
+    ValueError: not a string, an unknown family, or a malformed name (one line).
+  """
+  family = known_family(name)
   family.num_modules(name)
   return family
 
@@ -161,7 +171,7 @@ def num_modules(name: str) -> int:
   Raises:
     ValueError: an unknown or malformed name (one line).
   """
-  return checked_family(name).num_modules(name)
+  return known_family(name).num_modules(name)
 
 
 def length(name: str) -> float:
@@ -170,7 +180,7 @@ def length(name: str) -> float:
   Raises:
     ValueError: an unknown or malformed name (one line).
   """
-  family = checked_family(name)
+  family = known_family(name)
   return float(sum((family.module_length,) * family.num_modules(name)))  # As SoftArm.length sums.
 
 
