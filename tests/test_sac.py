@@ -148,3 +148,56 @@ def test_the_arms_of_the_vector_stream_start_the_sequence_s_episodes_in_order(ho
   for observation in observations:
     np.testing.assert_array_equal(observation, serial.reset()[0])
   assert batched.episodes_started == serial.episodes_started == 4
+
+
+@pytest.mark.parametrize("reward", streams.REWARDS)
+def test_a_training_step_rewards_the_task_or_the_distance_to_the_targets(home, reward):
+  arm = robots.make(ROBOT)
+  dataset = data.collect(
+    ROBOT, samples=TINY.samples, seed=inverse_training.DATA_SEED, progress=False
+  )
+  stream = streams.training_targets(dataset, 10)
+  env = streams.TargetStreamEnv(arm, stream, 10, seed=4, reward=reward)
+  env.reset()
+  task_env = streams.TargetStreamEnv(arm, stream, 10, seed=4)
+  task_env.reset()
+  for action in np.random.default_rng(0).uniform(-1, 1, (3, arm.action_dim)):
+    _, given, _, _, info = env.step(action)
+    _, task_reward, _, _, task_info = task_env.step(action)
+    error_m = np.mean(task_info["position_error_mm"]) / 1000.0
+    assert error_m > 0
+    if reward == "task":
+      assert given == task_reward
+    else:  # Minus the distance in arm lengths, dense where the task's reward is not.
+      assert given == pytest.approx(-error_m / arm.length, rel=1e-12)
+
+
+@pytest.mark.skipif(arms() == 1, reason="vector training needs MuJoCo 4's batch (physics v1)")
+def test_the_vector_stream_rewards_each_arm_as_its_serial_stream_does(home):
+  arm = robots.make(ROBOT)
+  dataset = data.collect(
+    ROBOT, samples=TINY.samples, seed=inverse_training.DATA_SEED, progress=False
+  )
+  stream = streams.training_targets(dataset, 10)
+  batched = streams.TargetStreamVectorEnv(
+    2, arm, stream, 10, seed=4, reward="distance", backend="cpu"
+  )
+  serial = [
+    streams.TargetStreamEnv(arm, stream, 10, seed=4, first_episode=arm_index, reward="distance")
+    for arm_index in range(2)
+  ]
+  batched.reset()
+  for env in serial:
+    env.reset()
+  for actions in np.random.default_rng(1).uniform(-1, 1, (3, 2, arm.action_dim)):
+    rewards = batched.step(actions)[1]
+    expected = [env.step(action)[1] for env, action in zip(serial, actions)]
+    np.testing.assert_array_equal(rewards, expected)
+    assert np.all(rewards < 0)
+
+
+def test_an_unknown_training_reward_is_one_line(home):
+  arm = robots.make(ROBOT)
+  stream = [np.zeros((10, 1, 6))]
+  with pytest.raises(ValueError, match="^reward must be one of task, distance, got 'sparse'$"):
+    streams.TargetStreamEnv(arm, stream, 10, seed=0, reward="sparse")

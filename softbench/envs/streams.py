@@ -6,12 +6,18 @@ learn from; the suite's ``babbling`` task follows held-out ones). Episode i foll
 ``episode_steps`` consecutive poses of one piece of that split, drawn, with its random start,
 from the stream ``seeding.TARGET_STREAM_EPISODES`` at index i: the sequence of episodes is fixed
 by the seed, so a training that resumes at episode i sees what it would have seen.
+
+A step's reward is the task's (``REWARDS``: ``task``, the suite's tolerance reward) or
+``distance``, minus the scored modules' mean distance to their targets in arm lengths: dense
+everywhere, where the tolerance reward flattens out far from the target (0.02 at 24 % of the arm's
+length).
 """
 
 import gymnasium
 from gymnasium.vector import AutoresetMode
 import numpy as np
 
+from softbench import metrics
 from softbench import robots
 from softbench import suite
 from softbench.data import dataset as babbling_dataset
@@ -20,6 +26,25 @@ from softbench.data import splits
 from softbench.envs import environment
 from softbench.envs import vector
 from softbench.suite import base as task_base
+
+REWARDS = ("task", "distance")  # What a training step may reward (module docstring).
+
+
+def checked_reward(reward: str) -> str:
+  """``reward``, if it is one of ``REWARDS``.
+
+  Raises:
+    ValueError: another reward (one line).
+  """
+  if reward not in REWARDS:
+    raise ValueError(f"reward must be one of {', '.join(REWARDS)}, got {reward!r}")
+  return reward
+
+
+def distance_reward(info: dict, length: float) -> float:
+  """The ``distance`` reward of a step whose ``info`` (``environment.errors``) scores an arm
+  ``length`` (m) long: minus the scored modules' mean distance to their targets, in arm lengths."""
+  return -float(np.mean(info["position_error_mm"])) / (length * metrics.MM_PER_M)
 
 
 def training_targets(data: babbling_dataset.Dataset, episode_steps: int) -> list[np.ndarray]:
@@ -72,8 +97,12 @@ class TargetStreamEnv(gymnasium.Env):
     seed: seed of the episode sequence.
     first_episode: the index of the episode that the first ``reset`` starts (a resumed
       training's next one).
+    reward: one of ``REWARDS``.
 
   ``reset``'s ``seed`` is not used: the episodes are the seed's sequence, in order.
+
+  Raises:
+    ValueError: a bad seed, stream or reward (one line).
   """
 
   metadata = {"render_modes": []}
@@ -85,7 +114,9 @@ class TargetStreamEnv(gymnasium.Env):
     episode_steps: int,
     seed: int,
     first_episode: int = 0,
+    reward: str = "task",
   ):
+    self.reward = checked_reward(reward)
     self._sequence = EpisodeSequence(stream, episode_steps, seed)
     self.robot = robot
     self.episode_steps = episode_steps
@@ -107,7 +138,10 @@ class TargetStreamEnv(gymnasium.Env):
     return self._env.reset(seed=start_seed)
 
   def step(self, action):
-    return self._env.step(action)
+    observation, reward, terminated, truncated, info = self._env.step(action)
+    if self.reward == "distance":
+      reward = distance_reward(info, self.robot.length)
+    return observation, reward, terminated, truncated, info
 
 
 class TargetStreamVectorEnv(vector.SoftArmVectorEnv):
@@ -118,7 +152,8 @@ class TargetStreamVectorEnv(vector.SoftArmVectorEnv):
 
   Args:
     num_envs: how many arms.
-    robot, stream, episode_steps, seed, first_episode: as ``TargetStreamEnv`` takes them.
+    robot, stream, episode_steps, seed, first_episode, reward: as ``TargetStreamEnv`` takes
+      them.
     **options: ``SoftArmVectorEnv``'s (``backend``, ``threads``).
   """
 
@@ -130,8 +165,10 @@ class TargetStreamVectorEnv(vector.SoftArmVectorEnv):
     episode_steps: int,
     seed: int,
     first_episode: int = 0,
+    reward: str = "task",
     **options,
   ):
+    self.reward = checked_reward(reward)
     self._sequence = EpisodeSequence(stream, episode_steps, seed)
     self.episode_steps = episode_steps
     self.episodes_started = first_episode
@@ -151,3 +188,9 @@ class TargetStreamVectorEnv(vector.SoftArmVectorEnv):
     task = suite.build_task(self.robot, "custom", trajectory=targets)[1]
     task.reseed(start_seed)
     return task
+
+  def _scores(self, arms: np.ndarray, poses: np.ndarray, targets: dict) -> tuple[list, list]:
+    rewards, infos = super()._scores(arms, poses, targets)
+    if self.reward == "distance":
+      rewards = [distance_reward(info, self.robot.length) for info in infos]
+    return rewards, infos
