@@ -21,6 +21,8 @@ from softbench import leaderboard
 from softbench import profiles
 from softbench import storage
 from softbench import zoo
+from softbench.continual import strategies
+from softbench.continual import streams
 from softbench.data import dataset as data_files
 from softbench.learning import inverse as inverse_training
 from softbench.learning import protocols
@@ -164,6 +166,15 @@ def interrupted_training(monkeypatch):
         yield
 
   return interrupted
+
+
+@pytest.fixture
+def registries(monkeypatch):
+  """The continual stream and strategy registries as they are, restored after the test."""
+  monkeypatch.setattr(streams, "_STREAMS", dict(streams._STREAMS))
+  monkeypatch.setattr(streams, "STREAMS", streams.STREAMS)
+  monkeypatch.setattr(strategies, "_STRATEGIES", dict(strategies._STRATEGIES))
+  monkeypatch.setattr(strategies, "STRATEGIES", strategies.STRATEGIES)
 
 
 @pytest.fixture

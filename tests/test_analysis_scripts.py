@@ -9,6 +9,7 @@ import signal
 import sys
 import threading
 
+import example_strategy
 import pytest
 
 from softbench import cli
@@ -17,6 +18,8 @@ from softbench import records
 from softbench import robots
 from softbench.agents import hyperparameters
 from softbench.agents import learners
+from softbench.continual import streams
+from softbench.data import splits
 from softbench.learning import inverse as inverse_training
 from softbench.robots import versions
 from softbench.runners import run
@@ -368,3 +371,18 @@ def test_ewc_lambda_scores_both_configurations_for_every_lambda(monkeypatch, cap
   assert [row["lambda"] for row in rows] == [0.0, 1e7]
   for row in rows:
     assert row["mean"] == pytest.approx((row["first"] + row["second"]) / 2)
+
+
+def test_stream_coverage_measures_every_configuration_of_a_stream(registries, monkeypatch, capsys):
+  streams.register(example_strategy.LOADED)  # tendon-1, then carrying 5 g.
+  arguments = ["--streams", "loaded-pair", "--profile", "tiny", "--radius-mm", "1000"]
+  out = run_script("stream_coverage", arguments, monkeypatch, capsys)
+  number = r" +([\d.]+)"
+  rows = re.findall(rf"^loaded-pair +(\d+ g){number * 5}$", out, re.MULTILINE)
+  assert [row[0] for row in rows] == ["0 g", "5 g"]
+  dataset = data.collect("tendon-1", samples=200, seed=0, progress=False)
+  training = sum(piece.samples for piece in splits.split_pieces(dataset.episode_lengths)["train"])
+  for _, samples, spread, nearest, farthest, within in rows:
+    assert int(samples) == training
+    assert 0 < float(nearest) <= float(farthest) and float(spread) > 0
+    assert float(within) == training  # Every sample lies within 1 m of a 5 cm arm's targets.

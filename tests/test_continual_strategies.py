@@ -38,15 +38,6 @@ LEARNING = dataclasses.replace(TINY, max_epochs=10, patience=10)
 
 
 @pytest.fixture
-def registries(monkeypatch):
-  """The stream and strategy registries as they are, restored after the test."""
-  monkeypatch.setattr(streams, "_STREAMS", dict(streams._STREAMS))
-  monkeypatch.setattr(streams, "STREAMS", streams.STREAMS)
-  monkeypatch.setattr(strategies, "_STRATEGIES", dict(strategies._STRATEGIES))
-  monkeypatch.setattr(strategies, "STRATEGIES", strategies.STRATEGIES)
-
-
-@pytest.fixture
 def pair(registries, tmp_path, babbled_home):
   """``PAIR`` registered, in a data home with tendon-1's and tendon-2's tiny datasets."""
   for robot in ("tendon-1", "tendon-2"):
