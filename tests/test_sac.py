@@ -45,6 +45,15 @@ def home(tmp_path, monkeypatch, babbled_home):
   return tmp_path / "home"
 
 
+@pytest.fixture
+def stream(home) -> list[np.ndarray]:
+  """The training stream of 10-step episodes on the tiny dataset of ``ROBOT``."""
+  dataset = data.collect(
+    ROBOT, samples=TINY.samples, seed=inverse_training.DATA_SEED, progress=False
+  )
+  return streams.training_targets(dataset, 10)
+
+
 def _weights(trained: dict) -> dict[str, torch.Tensor]:
   import io  # pylint: disable=import-outside-toplevel
 
@@ -136,12 +145,8 @@ def test_policy_input_scales_positions_only():
 
 
 @pytest.mark.skipif(arms() == 1, reason="vector training needs MuJoCo 4's batch (physics v1)")
-def test_the_arms_of_the_vector_stream_start_the_sequence_s_episodes_in_order(home):
+def test_the_arms_of_the_vector_stream_start_the_sequence_s_episodes_in_order(stream):
   arm = robots.make(ROBOT)
-  dataset = data.collect(
-    ROBOT, samples=TINY.samples, seed=inverse_training.DATA_SEED, progress=False
-  )
-  stream = streams.training_targets(dataset, 10)
   batched = streams.TargetStreamVectorEnv(3, arm, stream, 10, seed=4, first_episode=1)
   serial = streams.TargetStreamEnv(arm, stream, 10, seed=4, first_episode=1)
   observations, _ = batched.reset()
@@ -151,12 +156,8 @@ def test_the_arms_of_the_vector_stream_start_the_sequence_s_episodes_in_order(ho
 
 
 @pytest.mark.parametrize("reward", streams.REWARDS)
-def test_a_training_step_rewards_the_task_or_the_distance_to_the_targets(home, reward):
+def test_a_training_step_rewards_the_task_or_the_distance_to_the_targets(stream, reward):
   arm = robots.make(ROBOT)
-  dataset = data.collect(
-    ROBOT, samples=TINY.samples, seed=inverse_training.DATA_SEED, progress=False
-  )
-  stream = streams.training_targets(dataset, 10)
   env = streams.TargetStreamEnv(arm, stream, 10, seed=4, reward=reward)
   env.reset()
   task_env = streams.TargetStreamEnv(arm, stream, 10, seed=4)
@@ -173,12 +174,8 @@ def test_a_training_step_rewards_the_task_or_the_distance_to_the_targets(home, r
 
 
 @pytest.mark.skipif(arms() == 1, reason="vector training needs MuJoCo 4's batch (physics v1)")
-def test_the_vector_stream_rewards_each_arm_as_its_serial_stream_does(home):
+def test_the_vector_stream_rewards_each_arm_as_its_serial_stream_does(stream):
   arm = robots.make(ROBOT)
-  dataset = data.collect(
-    ROBOT, samples=TINY.samples, seed=inverse_training.DATA_SEED, progress=False
-  )
-  stream = streams.training_targets(dataset, 10)
   batched = streams.TargetStreamVectorEnv(
     2, arm, stream, 10, seed=4, reward="distance", backend="cpu"
   )
