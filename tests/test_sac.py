@@ -13,6 +13,8 @@ from smpl import snapshots
 from softbench import data
 from softbench import profiles
 from softbench import robots
+from softbench.agents import base
+from softbench.agents import completion
 from softbench.agents import sac
 from softbench.data import splits
 from softbench.envs import environment
@@ -198,3 +200,34 @@ def test_an_unknown_training_reward_is_one_line(home):
   stream = [np.zeros((10, 1, 6))]
   with pytest.raises(ValueError, match="^reward must be one of task, distance, got 'sparse'$"):
     streams.TargetStreamEnv(arm, stream, 10, seed=0, reward="sparse")
+
+
+def test_a_partial_target_is_completed_with_the_nearest_babbling_pose_on_v1_held_on_v0(
+  home, monkeypatch
+):
+  arm = robots.make(ROBOT)
+  agent = sac.build(arm, 0, TINY)
+  shown = []
+
+  def predict(observation, deterministic):
+    shown.append(observation)
+    return np.zeros(arm.action_dim, np.float32), None
+
+  monkeypatch.setattr(agent._model, "predict", predict)  # pylint: disable=protected-access
+  start = np.array([[0.0, 0.0, arm.length, 0.0, 0.0, 1.0]])
+  goal = np.array([[0.3, -0.2, 0.8]]) * arm.length  # Module 1's position only, as reach gives.
+  agent.reset(base.EpisodeInfo("reach", (1,)))
+  agent.act({"poses": start, "target": goal, "previous_action": np.zeros(arm.action_dim)})
+  shapes = {"poses": (1, 6), "target": (1, 6), "previous_action": (arm.action_dim,)}
+  target = shown[0][environment.layout(shapes)["target"]]
+  np.testing.assert_allclose(target[:3], goal[0] / arm.length, rtol=1e-6)
+  if arms() == 1:  # v0: the starting pose's orientation, as its records were made.
+    np.testing.assert_allclose(target[3:], start[0, 3:], rtol=1e-6)
+  else:  # v1: that of the babbling pose nearest the goal, which it trained to reach.
+    dataset = data.collect(
+      ROBOT, samples=TINY.samples, seed=inverse_training.DATA_SEED, progress=False
+    )
+    poses = completion.Candidates.from_dataset(dataset).poses[:, 0]
+    nearest = poses[np.argmin(np.linalg.norm(poses[:, :3] - goal[0], axis=1))]
+    np.testing.assert_allclose(target[3:], nearest[3:], rtol=1e-6)
+    assert not np.allclose(nearest[3:], start[0, 3:])

@@ -13,6 +13,7 @@ training resumes from its saved state (model, optimisers, replay buffer, random 
 at least every ``snapshots.SAVE_INTERVAL_S``) to the same weights as an uninterrupted one.
 """
 
+from collections.abc import Callable
 import dataclasses
 import io
 import pathlib
@@ -32,13 +33,16 @@ from softbench import profiles
 from softbench import progress as progress_bars
 from softbench import storage
 from softbench.agents import base
+from softbench.agents import completion
 from softbench.agents import sb3_vector
 from softbench.envs import environment
 from softbench.envs import streams
 from softbench.learning import checkpoints
 from softbench.learning import inverse as inverse_training
 from softbench.robots import base as robot_base
+from softbench.robots import recorder
 from softbench.robots import versions
+from softbench.suite import trajectories
 
 EPISODE_STEPS = 50  # Control steps (targets) per training episode.
 STEPS = {"paper": 300_000, "default": 30_000, "tiny": 100}  # Environment steps per profile.
@@ -394,24 +398,61 @@ class SACAgent(base.Agent):
   """Acts with a trained SAC policy, deterministically (the mean action).
 
   It was trained to reach whole-arm poses: a task that scores some modules, or positions only
-  (reach), has its target completed as the learned agents' ``hold`` rule does: every module's
-  starting pose, the scored modules' given parts replaced by the target.
+  (reach), has its target completed. With ``candidates`` (physics v1) as the learned agents'
+  ``nearest`` helper does (``agents.completion``): the babbling training pose whose given part
+  lies nearest the goal (the poses it trained to reach), a still goal corrected from the measured
+  error. Without (v0, whose records were made so) by the ``hold`` rule: every module's starting
+  pose, the scored modules' given parts replaced by the target; a whole-arm target no action
+  reaches where the given module moves far (tendon-3's reach: 70.81 mm against 79.39 for
+  the zero agent).
   """
 
-  def __init__(self, robot: robot_base.SoftArm, seed: int, trained: dict):
+  def __init__(
+    self,
+    robot: robot_base.SoftArm,
+    seed: int,
+    trained: dict,
+    candidates: Callable[[], completion.Candidates] | None = None,
+  ):
     super().__init__(robot, seed)
     self._model = stable_baselines3.SAC.load(io.BytesIO(trained["model"]), device="cpu")
+    self._completer = None
+    if candidates is not None:
+      self._completer = completion.Completer(
+        candidates, _no_forward_model, robot.length, robot.control_timestep
+      )
 
   def reset(self, episode: base.EpisodeInfo) -> None:
     self._scored = np.array(episode.scored_modules) - 1
     self._start = None
+    if self._completer is not None:
+      self._completer.reset()
 
-  def act(self, observation: dict) -> np.ndarray:
-    if self._start is None:
-      self._start = np.array(observation["poses"], dtype=float)
-    given = np.asarray(observation["target"], dtype=float)
+  def _whole_target(self, given: np.ndarray, poses: np.ndarray) -> np.ndarray:
+    """Every module's target pose for the ``given`` part (class docstring)."""
+    if len(self._scored) == self.robot.num_modules and given.shape[1] == recorder.POSE_SIZE:
+      return given
+    if self._completer is not None:
+      return self._completer.complete(
+        given,
+        trajectories.Given(
+          tuple(int(module) + 1 for module in self._scored),
+          given.shape[1] == recorder.POSE_SIZE,
+        ),
+        poses,
+        poses,
+        np.ones(self.robot.action_dim, bool),
+        refine=False,
+      )
     target = self._start.copy()
     target[self._scored, : given.shape[1]] = given
+    return target
+
+  def act(self, observation: dict) -> np.ndarray:
+    poses = np.array(observation["poses"], dtype=float)
+    if self._start is None:
+      self._start = poses
+    target = self._whole_target(np.asarray(observation["target"], dtype=float), poses)
     whole = {**observation, "target": target}
     shapes = {key: np.shape(whole[key]) for key in environment.KEYS}
     action, _ = self._model.predict(
@@ -420,10 +461,22 @@ class SACAgent(base.Agent):
     return np.asarray(action, dtype=np.float64)
 
 
+def _no_forward_model(*_) -> None:
+  raise RuntimeError("sac completes targets without refinement: it has no forward model")
+
+
 def build(
   robot: robot_base.SoftArm, seed: int, profile: profiles.Profile, show_progress: bool = False
 ) -> base.Agent:
-  return SACAgent(robot, seed, train(robot, seed, profile, show_progress))
+
+  def candidates() -> completion.Candidates:
+    return completion.Candidates.from_dataset(
+      data.collect(robot, samples=profile.samples, seed=inverse_training.DATA_SEED, progress=False)
+    )
+
+  one_arm = versions.current().name == versions.FIRST  # v0 kept the hold rule.
+  trained = train(robot, seed, profile, show_progress)
+  return SACAgent(robot, seed, trained, None if one_arm else candidates)
 
 
 def training_summary(
