@@ -9,6 +9,7 @@ import json
 import example_strategy
 import numpy as np
 import pytest
+import torch
 
 from softbench import cli
 from softbench import leaderboard
@@ -238,3 +239,18 @@ def test_the_leaderboard_shows_a_table_per_stream_with_forward_transfer(
     text = page.read_text()
     assert group.title in text and "normalised tip error (%) of each configuration" in text
   assert_regenerates_identically(results, tmp_path)
+
+
+@pytest.mark.parametrize("name", strategies.STRATEGIES)
+def test_a_run_that_resumes_after_a_cached_stage_learns_the_next_to_the_same_weights(name, pair):
+  *_, (whole, _, _) = continual_learning.learn(name, PAIR, "tendon", 0, TINY)
+  configurations = PAIR.configurations("tendon")
+  cache = continual_learning.folder(
+    continual_learning.config(name, PAIR.name, configurations, 0, TINY)
+  )
+  continual_learning.stage_path(cache, 1).unlink()  # Stopped after its first stage.
+  *_, (resumed, _, _) = continual_learning.learn(name, PAIR, "tendon", 0, TINY)
+  first, second = whole.module.state_dict(), resumed.module.state_dict()
+  assert first.keys() == second.keys()
+  for key in first:
+    assert torch.equal(first[key], second[key]), key

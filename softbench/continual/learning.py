@@ -241,8 +241,9 @@ def _cached(path: pathlib.Path, strategy: strategy_base.Strategy) -> dict | None
 
   def load(found: pathlib.Path) -> dict:
     saved = torch.load(found, map_location="cpu", weights_only=True)
+    # The weights only: which parameters a later stage trains is the strategy's (SMPL's and
+    # independent's earlier networks stay out of later trainings; a shared network trains on).
     strategy.module.load_state_dict(saved["state"])
-    strategy.module.requires_grad_(False)
     return saved["summary"]
 
   return storage.read_cached(path, load, "continual stage", "learning it again")
