@@ -16,22 +16,16 @@ import argparse
 import numpy as np
 from scipy import spatial
 
-from softbench import data
 from softbench import metrics
 from softbench import profiles
 from softbench import suite
+from softbench.agents import learned
 from softbench.continual import streams
-from softbench.data import splits
-from softbench.learning import inverse as inverse_training
 
 
 def training_tips_mm(robot, profile: profiles.Profile) -> np.ndarray:
   """The end effector's positions (mm) reached in ``robot``'s babbling training split."""
-  dataset = data.collect(
-    robot, samples=profile.samples, seed=inverse_training.DATA_SEED, progress=False
-  )
-  pieces = splits.split_pieces(dataset.episode_lengths)["train"]
-  poses = np.concatenate([piece.recording(dataset)[0][1:] for piece in pieces])
+  poses = learned.babbling_candidates(robot, profile).poses
   return poses[:, -1, :3] * metrics.MM_PER_M
 
 

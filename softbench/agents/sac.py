@@ -34,6 +34,7 @@ from softbench import progress as progress_bars
 from softbench import storage
 from softbench.agents import base
 from softbench.agents import completion
+from softbench.agents import learned
 from softbench.agents import sb3_vector
 from softbench.envs import environment
 from softbench.envs import streams
@@ -468,15 +469,10 @@ def _no_forward_model(*_) -> None:
 def build(
   robot: robot_base.SoftArm, seed: int, profile: profiles.Profile, show_progress: bool = False
 ) -> base.Agent:
-
-  def candidates() -> completion.Candidates:
-    return completion.Candidates.from_dataset(
-      data.collect(robot, samples=profile.samples, seed=inverse_training.DATA_SEED, progress=False)
-    )
-
   one_arm = versions.current().name == versions.FIRST  # v0 kept the hold rule.
   trained = train(robot, seed, profile, show_progress)
-  return SACAgent(robot, seed, trained, None if one_arm else candidates)
+  candidates = None if one_arm else lambda: learned.babbling_candidates(robot, profile)
+  return SACAgent(robot, seed, trained, candidates)
 
 
 def training_summary(
