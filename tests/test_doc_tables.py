@@ -218,6 +218,7 @@ def test_another_results_folder_has_no_doc_pages(tmp_path):
 
 
 README_MAX_LINES = 300  # A page a user reads in about five minutes (issue 26).
+PROSE_COLUMNS = 100  # (characters) The code's line length (pyproject.toml), for written pages too.
 LINK = re.compile(r"\]\(<?([^)<>\s]+)>?\)")
 
 
@@ -232,3 +233,33 @@ def test_every_relative_link_names_a_file_of_the_checkout(page):
   local = [target for target in targets if target and "://" not in target]
   missing = [target for target in local if not (page.parent / target).exists()]
   assert missing == [], f"{page.name} links to files that do not exist: {missing}"
+
+
+def _long_prose_lines(text: str) -> list[int]:
+  """Numbers of the lines over ``PROSE_COLUMNS`` that a writer wraps: not code, tables, generated
+  table blocks, HTML or images, and not a single unbreakable word."""
+  long, fenced, generated = [], False, False
+  for number, line in enumerate(text.splitlines(), start=1):
+    if line.startswith("```"):
+      fenced = not fenced
+    elif "softbench:table" in line:
+      generated = "/softbench:table" not in line
+    elif not (fenced or generated) and len(line) > PROSE_COLUMNS:
+      words = re.sub(r"^\s*([-*] |\d+\. )?", "", line).split()
+      if not line.lstrip().startswith(("|", "<", "![")) and len(words) > 1:
+        long.append(number)
+  return long
+
+
+@pytest.mark.parametrize("page", [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))])
+def test_written_pages_wrap_their_prose_at_the_code_line_length(page):
+  long = _long_prose_lines(page.read_text(encoding="utf-8"))
+  assert long == [], f"{page.name}: lines over {PROSE_COLUMNS} characters: {long}"
+
+
+def test_the_prose_width_check_finds_a_long_line_and_spares_code_and_tables():
+  prose = "word " * 30
+  code, table, generated = f"```sh\n{prose}\n```\n", f"| {prose} |\n", _block("x", prose + "\n")
+  text = code + table + generated + f"- `one.unbreakable.word{'x' * 99}`\n"
+  assert _long_prose_lines(text) == []
+  assert _long_prose_lines(text + f"- {prose}\n") == [len(text.splitlines()) + 1]
