@@ -41,6 +41,13 @@ def test_committed_model_readme_is_identical_to_regenerated(name):
   assert (MODELS / name / "README.md").read_text() == export.readme(robots.make(name), speed)
 
 
+@pytest.mark.parametrize("name", robots.REGISTERED_ROBOTS)
+def test_committed_model_readme_wraps_its_prose(name):
+  lines = (MODELS / name / "README.md").read_text().splitlines()
+  long = [line for line in lines if len(line) > export.README_COLUMNS and line[:1] not in "|#"]
+  assert long == []
+
+
 def test_cli_export_writes_every_registered_model(tmp_path, monkeypatch):
   monkeypatch.setattr(export, "readme", lambda robot, speed: f"# {robot.name}\n")
   assert cli.main(["models", "export", "--out", str(tmp_path)]) == 0

@@ -11,12 +11,14 @@ import json
 import pathlib
 import platform
 import sys
+import textwrap
 
 from softbench.robots import base
 from softbench.robots import measure
 from softbench.storage import write_atomically
 
 SPEED_FILE = "speed.json"
+README_COLUMNS = 100  # (characters) Where the README's prose wraps, as the written docs do.
 
 _SCENE = """<mujoco model="{name} scene">
   <include file="{name}.xml"/>
@@ -107,7 +109,22 @@ def readme(robot: base.SoftArm, speed: dict | None) -> str:
       f"{speed['steps_per_second']:,} steps/s, "
       f"{speed['real_time_factor']}x real time ({speed['machine']})."
     )
-  return "\n".join(lines) + "\n"
+  return "\n".join(_wrapped(line) for line in lines) + "\n"
+
+
+def _wrapped(line: str) -> str:
+  """``line`` wrapped at ``README_COLUMNS``: a paragraph, or a bullet with its text indented;
+  headings and table rows as they are."""
+  if line.startswith(("#", "|")):
+    return line
+  indent = "  " if line.startswith("- ") else ""
+  return textwrap.fill(
+    line,
+    README_COLUMNS,
+    subsequent_indent=indent,
+    break_long_words=False,
+    break_on_hyphens=False,
+  )
 
 
 def _degrees(angles) -> str:
