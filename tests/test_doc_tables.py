@@ -242,8 +242,8 @@ def _long_prose_lines(text: str) -> list[int]:
   for number, line in enumerate(text.splitlines(), start=1):
     if line.startswith("```"):
       fenced = not fenced
-    elif "softbench:table" in line:
-      generated = "/softbench:table" not in line
+    elif line.startswith(("<!-- softbench:table", "<!-- /softbench:table")):
+      generated = not line.startswith("<!-- /")
     elif not (fenced or generated) and len(line) > PROSE_COLUMNS:
       words = re.sub(r"^\s*([-*] |\d+\. )?", "", line).split()
       if not line.lstrip().startswith(("|", "<", "![")) and len(words) > 1:
