@@ -128,8 +128,14 @@ class SacConfig:
     return storage.config_key(self, f"sac-{self.robot}-seed{self.seed}")
 
 
+def _on_first_physics() -> bool:
+  """Whether the installed physics is v0, whose records sac made on one arm, with the task's
+  reward and the hold rule."""
+  return versions.current().name == versions.FIRST
+
+
 def training_config(robot: robot_base.SoftArm, seed: int, profile: profiles.Profile) -> SacConfig:
-  one_arm = versions.current().name == versions.FIRST
+  one_arm = _on_first_physics()
   hyperparameters = HYPERPARAMETERS if one_arm else {**HYPERPARAMETERS, **VECTOR_HYPERPARAMETERS}
   return SacConfig(
     robot.name,
@@ -469,9 +475,9 @@ def _no_forward_model(*_) -> None:
 def build(
   robot: robot_base.SoftArm, seed: int, profile: profiles.Profile, show_progress: bool = False
 ) -> base.Agent:
-  one_arm = versions.current().name == versions.FIRST  # v0 kept the hold rule.
   trained = train(robot, seed, profile, show_progress)
-  candidates = None if one_arm else lambda: learned.babbling_candidates(robot, profile)
+  holds = _on_first_physics()  # v0's records completed targets by the hold rule.
+  candidates = None if holds else lambda: learned.babbling_candidates(robot, profile)
   return SACAgent(robot, seed, trained, candidates)
 
 
