@@ -210,16 +210,13 @@ class LearnedAgent(base.Agent):
 
   def _full_target(self, target: np.ndarray, poses: np.ndarray) -> np.ndarray:
     """Every module's target pose (module docstring: ``helper_targets``)."""
-    if len(self._scored) == self.robot.num_modules and target.shape[1] == 6:
+    if len(self._scored) == self.robot.num_modules and target.shape[1] == recorder.POSE_SIZE:
       return target  # Every module's whole pose is given.
     if self.helper_targets in ("complete", "nearest"):
       active_actions = np.repeat(self._module_active(), self.robot.actuators_per_module)
       return self._completer.complete(
         target,
-        trajectories.Given(
-          tuple(int(module) + 1 for module in self._scored),
-          target.shape[1] == recorder.POSE_SIZE,
-        ),
+        trajectories.Given.of_target(self._scored, target),
         self._previous_poses,
         poses,
         active_actions,

@@ -442,10 +442,7 @@ class SACAgent(base.Agent):
     if self._completer is not None:
       return self._completer.complete(
         given,
-        trajectories.Given(
-          tuple(int(module) + 1 for module in self._scored),
-          given.shape[1] == recorder.POSE_SIZE,
-        ),
+        trajectories.Given.of_target(self._scored, given),
         poses,
         poses,
         np.ones(self.robot.action_dim, bool),

@@ -55,6 +55,14 @@ class Given:
       raise ValueError(f"given orientation must be True or False, got {self.orientation!r}")
 
   @classmethod
+  def of_target(cls, modules_from_zero: np.ndarray, target: np.ndarray) -> "Given":
+    """The part a target of shape (len(modules), 3 or 6) gives of 0-based ``modules_from_zero``
+    (an agent's scored modules): positions only where it has 3 columns."""
+    return cls(
+      tuple(int(module) + 1 for module in modules_from_zero), target.shape[1] == recorder.POSE_SIZE
+    )
+
+  @classmethod
   def parse(cls, text: str, robot: base.SoftArm) -> "Given":
     """The mask of ``text``: modules separated by commas, then ``:position`` for positions only.
 
