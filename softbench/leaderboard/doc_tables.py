@@ -426,4 +426,8 @@ TABLES: dict[str, Callable[[ranking.Leaderboard], Table]] = {
   "continual-degrade-tendon-default-diagonal": continual_table(
     "degrade", "tendon", "default", True
   ),
+  "continual-grow-tendon-local-default": continual_table("grow", "tendon-local", "default"),
+  "continual-grow-tendon-local-default-diagonal": continual_table(
+    "grow", "tendon-local", "default", True
+  ),
 }
