@@ -386,3 +386,27 @@ def test_stream_coverage_measures_every_configuration_of_a_stream(registries, mo
     assert int(samples) == training
     assert 0 < float(nearest) <= float(farthest) and float(spread) > 0
     assert float(within) == training  # Every sample lies within 1 m of a 5 cm arm's targets.
+
+
+def test_stream_actions_compares_a_strategys_modules_with_the_reference(
+  registries, monkeypatch, capsys
+):
+  streams.register(example_strategy.LOADED)  # tendon-1, then carrying 5 g.
+  arguments = ["--stream", "loaded-pair", "--strategy", "independent", "--profile", "tiny"]
+  out = run_script("stream_actions", [*arguments, "--seeds", "0", "1"], monkeypatch, capsys)
+  number = r" +([\d.]+)"
+  module = rf"m1{number}{number}{number}"  # tendon-1: one module.
+  rows = re.findall(rf"^(\d+ g) +(reference|independent) +(\d+){number} +{module}$", out, re.M)
+  expected = [
+    (load, agent, seed)
+    for load in ("0 g", "5 g")
+    for seed in ("0", "1")
+    for agent in ("reference", "independent")
+  ]
+  assert [row[:3] for row in rows] == expected
+  for _, agent, _, error, mean, largest, saturated in rows:
+    assert float(error) >= 0 and 0 <= float(mean) <= float(largest) <= 1
+    assert 0 <= float(saturated) <= 1
+  reference_errors = [float(row[3]) for row in rows if row[1] == "reference"]
+  learned_errors = [float(row[3]) for row in rows if row[1] == "independent"]
+  assert max(reference_errors) < min(learned_errors)  # It plans on the simulator itself.

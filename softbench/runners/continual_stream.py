@@ -93,6 +93,23 @@ def episodes_folder(run: ContinualSettings) -> pathlib.Path:
   )
 
 
+def configuration_agent(
+  strategy: strategy_base.Strategy,
+  stage: strategy_base.StageData,
+  configuration: int,
+  seed: int,
+) -> learned.LearnedAgent:
+  """The agent that drives ``configuration``'s arm with ``strategy``'s controller for it, closed
+  loop in physics through the configuration's forward model (``stage``)."""
+  robot = stage.configuration.robot
+  controller = learned.Controller(
+    data.View.end_effector(robot), stage.forward.cpu().eval(), stage.windows.normalisation
+  )
+  return learned.LearnedAgent(
+    robot, seed, strategy.controller(configuration), [controller], learned.Acting("physics")
+  )
+
+
 def score_configuration(
   strategy: strategy_base.Strategy,
   stage: strategy_base.StageData,
@@ -111,12 +128,7 @@ def score_configuration(
   if found is not None:
     return found
   robot = stage.configuration.robot
-  controller = learned.Controller(
-    data.View.end_effector(robot), stage.forward.cpu().eval(), stage.windows.normalisation
-  )
-  agent = learned.LearnedAgent(
-    robot, seed, strategy.controller(configuration), [controller], learned.Acting("physics")
-  )
+  agent = configuration_agent(strategy, stage, configuration, seed)
   task = streams.get(run.stream).task
   env = suite.load(robot, task, seed=seed, **suite.length_options(task, run.profile.episode_length))
   episode = evaluation.run_episode(env, agent, task, show_progress)

@@ -1,0 +1,112 @@
+"""How hard a continual strategy drives each module, against the reference agent.
+
+For each chosen configuration of a continual stream, right after the stage that learned it
+(the strategy's cached stages, as `softbench run --protocol continual` trains them), and for the
+`reference` agent, which plans every action on that configuration's own simulator: the
+end-effector error (mm) of the stream's scored episode, and per module the mean |action|, its
+largest value and the share of action entries above SATURATED. A module the strategy drives
+less than the reference does is one its inverse model under-uses.
+
+Usage:
+  python docs/analysis/stream_actions.py --stream degrade --family tendon \
+      --strategy independent --seeds 0 1 2 --configurations 3 4 --profile default
+"""
+
+import argparse
+
+import numpy as np
+
+from softbench import agents
+from softbench import profiles
+from softbench import suite
+from softbench.continual import learning as continual_learning
+from softbench.continual import streams
+from softbench.runners import continual as exp1s_runner
+from softbench.runners import continual_stream
+from softbench.runners import evaluation
+
+SATURATED = 0.95  # |action| (action units) above which an entry counts as at its bound.
+
+
+def episode(agent, robot, task: str, seed: int, profile: profiles.Profile):
+  """The end-effector error (mm) and the actions (steps, action_dim) of ``agent``'s episode."""
+  actions = []
+  act = agent.act
+
+  def recorded(observation):
+    actions.append(np.asarray(act(observation), dtype=float))
+    return actions[-1]
+
+  agent.act = recorded
+  env = suite.load(robot, task, seed=seed, **suite.length_options(task, profile.episode_length))
+  scores = exp1s_runner.end_effector_scores(
+    evaluation.run_episode(env, agent, task, False), robot.length
+  )
+  return scores["position_mm"], np.array(actions)
+
+
+def describe(label: str, who: str, seed: int, error_mm: float, actions, robot) -> str:
+  """One printed row: the error, then each module's mean |action|, largest and saturated share."""
+  magnitudes = np.abs(actions)
+  ends = np.cumsum(robot.actuators_per_module)
+  modules = [
+    f"m{number} {part.mean():.3f} {part.max():.3f} {np.mean(part > SATURATED):.3f}"
+    for number, part in enumerate(np.split(magnitudes, ends[:-1], axis=1), start=1)
+  ]
+  return f"{label:14s} {who:12s} {seed:4d} {error_mm:10.4f}   " + "   ".join(modules)
+
+
+def main() -> None:
+  parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+  parser.add_argument("--stream", default="degrade")
+  parser.add_argument("--family", default="tendon")
+  parser.add_argument("--strategy", default="independent")
+  parser.add_argument("--seeds", type=int, nargs="+", default=[0])
+  parser.add_argument("--configurations", type=int, nargs="+", help="1-based; default: all")
+  parser.add_argument("--profile", default="default")
+  args = parser.parse_args()
+  profile = profiles.get(args.profile)
+  stream = streams.get(args.stream)
+  configurations = stream.configurations(args.family)
+  chosen = args.configurations or range(1, len(configurations) + 1)
+  print(
+    f"{'configuration':14s} {'agent':12s} {'seed':>4s} {'error (mm)':>10s}   "
+    f"per module: mean |action|, largest, share above {SATURATED}"
+  )
+  for number in chosen:
+    configuration = configurations[number - 1]
+    robot = configuration.robot
+    for seed in args.seeds:
+      reference = agents.make("reference", robot, seed, profile)
+      print(
+        describe(
+          configuration.label,
+          "reference",
+          seed,
+          *episode(reference, robot, stream.task, seed, profile),
+          robot,
+        ),
+        flush=True,
+      )
+      for strategy, stages, summary in continual_learning.learn(
+        args.strategy, stream, args.family, seed, profile
+      ):
+        if summary["stage"] == number - 1:
+          agent = continual_stream.configuration_agent(
+            strategy, stages[number - 1], number - 1, seed
+          )
+          print(
+            describe(
+              configuration.label,
+              args.strategy,
+              seed,
+              *episode(agent, robot, stream.task, seed, profile),
+              robot,
+            ),
+            flush=True,
+          )
+          break
+
+
+if __name__ == "__main__":
+  main()
