@@ -3,14 +3,17 @@ strategy and stream: each learns a tiny two-stage stream (tendon-1, then tendon-
 in physics after every stage; SMPL forgets nothing to the bit; finetuning forgets and replay and
 EWC forget less; an outside strategy and stream join by ``register``; bad input is one line."""
 
+import contextlib
 import dataclasses
 import json
+import time
 
 import example_strategy
 import numpy as np
 import pytest
 import torch
 
+from smpl import snapshots
 from softbench import cli
 from softbench import leaderboard
 from softbench import profiles
@@ -239,6 +242,37 @@ def test_the_leaderboard_shows_a_table_per_stream_with_forward_transfer(
     text = page.read_text()
     assert group.title in text and "normalised tip error (%) of each configuration" in text
   assert_regenerates_identically(results, tmp_path)
+
+
+def test_a_stage_stopped_mid_training_counts_its_earlier_epochs_when_it_resumes(pair, monkeypatch):
+  """A stage stopped after two epochs, whose clock ran EPOCH_S an epoch, then resumed: its
+  training_seconds holds those two epochs, not only the time since the resume."""
+  epoch_s, stopped_after = 500.0, 2
+  monkeypatch.setattr(snapshots, "SAVE_INTERVAL_S", 0.0)  # A snapshot after every epoch.
+
+  def stop_after_two(report):
+    if report.epoch + 1 == stopped_after:
+      raise KeyboardInterrupt
+
+  clock = iter(range(0, 10**6, int(epoch_s)))
+  with monkeypatch.context() as stopped:
+    stopped.setattr(time, "perf_counter", lambda: float(next(clock)))
+    stopped.setattr(  # Only the stage's training, not the forward models' before it.
+      continual_learning.progress_bars,
+      "epochs",
+      lambda label, *_: contextlib.nullcontext(
+        stop_after_two if "pair seed" in (label or "") else None
+      ),
+    )
+    with pytest.raises(KeyboardInterrupt):
+      next(continual_learning.learn("independent", PAIR, "tendon", 0, LEARNING))
+  started = time.perf_counter()
+  _, _, summary = next(continual_learning.learn("independent", PAIR, "tendon", 0, LEARNING))
+  since_resume = time.perf_counter() - started
+  assert summary["epochs"][0] > stopped_after  # It went on training after the resume.
+  assert (
+    stopped_after * epoch_s <= summary["training_seconds"] <= stopped_after * epoch_s + since_resume
+  )
 
 
 @pytest.mark.parametrize("name", strategies.STRATEGIES)

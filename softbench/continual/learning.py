@@ -197,11 +197,12 @@ def learn(
   """After each stage of ``stream`` (on ``family``) learned by ``strategy_name`` with ``seed``:
   the strategy, every stage's data, and the stage's summary: ``trained_on`` (configurations
   whose data it read), per fit ``epochs``, ``best_validation_loss`` and ``validation_curve``
-  (each epoch's validation loss), ``training_seconds`` (the stage's learning when it ran),
-  ``parameters`` (after the stage), ``parameters_trained`` (those the stage changed),
-  ``carried_values`` (every number the strategy carries to the next stage: weights, Fisher
-  information, buffers) and the model-level ``model_pose_mse`` and ``model_action_mse`` of
-  configurations 0..s. From the cache where a stage was learned before."""
+  (each epoch's validation loss), ``training_seconds`` (the stage's learning, with the epochs a
+  resumed training ran before it stopped), ``parameters`` (after the stage),
+  ``parameters_trained`` (those the stage changed), ``carried_values`` (every number the
+  strategy carries to the next stage: weights, Fisher information, buffers) and the model-level
+  ``model_pose_mse`` and ``model_action_mse`` of configurations 0..s. From the cache where a
+  stage was learned before."""
   configurations = stream.configurations(family)
   stages = stage_data(configurations, seed, profile, show_progress)
   strategies.strategy_class(strategy_name).check(configurations)
@@ -220,12 +221,30 @@ def learn(
         snapshots.resumable(cache / f"stage{stage}.partial"),
         progress_bars.epochs(label, profile.max_epochs, show_progress) as bar,
       ):
-        trained = strategy.learn(stage, seen, bar)
-      seconds = time.perf_counter() - started
+        earlier = EarlierEpochs(bar)
+        trained = strategy.learn(stage, seen, earlier)
+      seconds = time.perf_counter() - started + earlier.seconds
       summary = _summary(strategy, stage, stages, trained, before, seconds)
       _save(path, strategy, summary)
       snapshots.discard(cache / f"stage{stage}.partial")
     yield strategy, stages, summary
+
+
+class EarlierEpochs:
+  """The epoch callback a stage's learning gets: adds up the seconds of the epochs a resumed
+  training ran before it was stopped (``smpl.fitting`` hands them on again, marked ``resumed``),
+  so that a stage's ``training_seconds`` counts them, then passes every report to ``forward``
+  (a progress bar's callback, or None)."""
+
+  def __init__(self, forward) -> None:
+    self.forward = forward
+    self.seconds = 0.0
+
+  def __call__(self, report: fitting.EpochReport) -> None:
+    if report.resumed:
+      self.seconds += report.seconds
+    if self.forward is not None:
+      self.forward(report)
 
 
 def _save(path: pathlib.Path, strategy: strategy_base.Strategy, summary: dict) -> None:
