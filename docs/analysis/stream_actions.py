@@ -45,8 +45,10 @@ def episode(agent, robot, task: str, seed: int, profile: profiles.Profile):
   return scores["position_mm"], np.array(actions)
 
 
-def describe(label: str, who: str, seed: int, error_mm: float, actions, robot) -> str:
-  """One printed row: the error, then each module's mean |action|, largest and saturated share."""
+def row(label: str, who: str, agent, robot, task: str, seed: int, profile) -> str:
+  """One printed row of ``agent``'s episode: the error, then each module's mean |action|, largest
+  and saturated share."""
+  error_mm, actions = episode(agent, robot, task, seed, profile)
   magnitudes = np.abs(actions)
   ends = np.cumsum(robot.actuators_per_module)
   modules = [
@@ -79,13 +81,7 @@ def main() -> None:
     for seed in args.seeds:
       reference = agents.make("reference", robot, seed, profile)
       print(
-        describe(
-          configuration.label,
-          "reference",
-          seed,
-          *episode(reference, robot, stream.task, seed, profile),
-          robot,
-        ),
+        row(configuration.label, "reference", reference, robot, stream.task, seed, profile),
         flush=True,
       )
       for strategy, stages, summary in continual_learning.learn(
@@ -96,13 +92,7 @@ def main() -> None:
             strategy, stages[number - 1], number - 1, seed
           )
           print(
-            describe(
-              configuration.label,
-              args.strategy,
-              seed,
-              *episode(agent, robot, stream.task, seed, profile),
-              robot,
-            ),
+            row(configuration.label, args.strategy, agent, robot, stream.task, seed, profile),
             flush=True,
           )
           break
