@@ -399,8 +399,8 @@ def test_stream_actions_compares_a_strategys_modules_with_the_reference(
   rows = re.findall(rf"^(\d+ g) +(reference|independent) +(\d+){number} +{module}$", out, re.M)
   expected = [
     (load, agent, seed)
-    for load in ("0 g", "5 g")
     for seed in ("0", "1")
+    for load in ("0 g", "5 g")
     for agent in ("reference", "independent")
   ]
   assert [row[:3] for row in rows] == expected

@@ -245,7 +245,7 @@ def test_the_leaderboard_shows_a_table_per_stream_with_forward_transfer(
 
 
 def test_a_stage_stopped_mid_training_counts_its_earlier_epochs_when_it_resumes(pair, monkeypatch):
-  """A stage stopped after two epochs, whose clock ran EPOCH_S an epoch, then resumed: its
+  """A stage stopped after two epochs, whose clock ran epoch_s an epoch, then resumed: its
   training_seconds holds those two epochs, not only the time since the resume."""
   epoch_s, stopped_after = 500.0, 2
   monkeypatch.setattr(snapshots, "SAVE_INTERVAL_S", 0.0)  # A snapshot after every epoch.

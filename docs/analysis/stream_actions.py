@@ -18,18 +18,16 @@ import numpy as np
 
 from softbench import agents
 from softbench import profiles
-from softbench import suite
 from softbench.continual import learning as continual_learning
 from softbench.continual import streams
-from softbench.runners import continual as exp1s_runner
 from softbench.runners import continual_stream
-from softbench.runners import evaluation
 
 SATURATED = 0.95  # |action| (action units) above which an entry counts as at its bound.
 
 
-def episode(agent, robot, task: str, seed: int, profile: profiles.Profile):
-  """The end-effector error (mm) and the actions (steps, action_dim) of ``agent``'s episode."""
+def episode(agent, task: str, seed: int, profile: profiles.Profile):
+  """The end-effector error (mm) and the actions (steps, action_dim) of ``agent``'s episode,
+  scored as the continual records score it."""
   actions = []
   act = agent.act
 
@@ -38,19 +36,16 @@ def episode(agent, robot, task: str, seed: int, profile: profiles.Profile):
     return actions[-1]
 
   agent.act = recorded
-  env = suite.load(robot, task, seed=seed, **suite.length_options(task, profile.episode_length))
-  scores = exp1s_runner.end_effector_scores(
-    evaluation.run_episode(env, agent, task, False), robot.length
-  )
+  scores = continual_stream.end_effector_episode(agent, task, seed, profile)
   return scores["position_mm"], np.array(actions)
 
 
-def row(label: str, who: str, agent, robot, task: str, seed: int, profile) -> str:
+def row(label: str, who: str, agent, task: str, seed: int, profile) -> str:
   """One printed row of ``agent``'s episode: the error, then each module's mean |action|, largest
   and saturated share."""
-  error_mm, actions = episode(agent, robot, task, seed, profile)
+  error_mm, actions = episode(agent, task, seed, profile)
   magnitudes = np.abs(actions)
-  ends = np.cumsum(robot.actuators_per_module)
+  ends = np.cumsum(agent.robot.actuators_per_module)
   modules = [
     f"m{number} {part.mean():.3f} {part.max():.3f} {np.mean(part > SATURATED):.3f}"
     for number, part in enumerate(np.split(magnitudes, ends[:-1], axis=1), start=1)
@@ -75,27 +70,22 @@ def main() -> None:
     f"{'configuration':14s} {'agent':12s} {'seed':>4s} {'error (mm)':>10s}   "
     f"per module: mean |action|, largest, share above {SATURATED}"
   )
-  for number in chosen:
-    configuration = configurations[number - 1]
-    robot = configuration.robot
-    for seed in args.seeds:
+  for seed in args.seeds:  # One pass over the seed's cached stages.
+    for strategy, stages, summary in continual_learning.learn(
+      args.strategy, stream, args.family, seed, profile
+    ):
+      configuration = summary["stage"]
+      if configuration + 1 not in chosen:
+        continue
+      label, robot = configurations[configuration].label, configurations[configuration].robot
       reference = agents.make("reference", robot, seed, profile)
-      print(
-        row(configuration.label, "reference", reference, robot, stream.task, seed, profile),
-        flush=True,
+      print(row(label, "reference", reference, stream.task, seed, profile), flush=True)
+      agent = continual_stream.configuration_agent(
+        strategy, stages[configuration], configuration, seed
       )
-      for strategy, stages, summary in continual_learning.learn(
-        args.strategy, stream, args.family, seed, profile
-      ):
-        if summary["stage"] == number - 1:
-          agent = continual_stream.configuration_agent(
-            strategy, stages[number - 1], number - 1, seed
-          )
-          print(
-            row(configuration.label, args.strategy, agent, robot, stream.task, seed, profile),
-            flush=True,
-          )
-          break
+      print(row(label, args.strategy, agent, stream.task, seed, profile), flush=True)
+      if configuration + 1 == max(chosen):
+        break  # The later stages are not asked for.
 
 
 if __name__ == "__main__":

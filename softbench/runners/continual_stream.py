@@ -23,6 +23,7 @@ from softbench import data
 from softbench import metrics
 from softbench import profiles
 from softbench import suite
+from softbench.agents import base as base_agent
 from softbench.agents import learned
 from softbench.continual import learning as continual_learning
 from softbench.continual import metrics as continual_metrics
@@ -110,6 +111,21 @@ def configuration_agent(
   )
 
 
+def end_effector_episode(
+  agent: base_agent.Agent,
+  task: str,
+  seed: int,
+  profile: profiles.Profile,
+  show_progress: bool = False,
+) -> dict:
+  """The end-effector scores of one seeded episode of ``task`` that ``agent`` drives on its
+  robot, as a stage's configuration is scored."""
+  robot = agent.robot
+  env = suite.load(robot, task, seed=seed, **suite.length_options(task, profile.episode_length))
+  episode = evaluation.run_episode(env, agent, task, show_progress)
+  return exp1s_runner.end_effector_scores(episode, robot.length)
+
+
 def score_configuration(
   strategy: strategy_base.Strategy,
   stage: strategy_base.StageData,
@@ -127,12 +143,9 @@ def score_configuration(
   found = episode_snapshots.load_scores(path, subject)
   if found is not None:
     return found
-  robot = stage.configuration.robot
   agent = configuration_agent(strategy, stage, configuration, seed)
   task = streams.get(run.stream).task
-  env = suite.load(robot, task, seed=seed, **suite.length_options(task, run.profile.episode_length))
-  episode = evaluation.run_episode(env, agent, task, show_progress)
-  scores = exp1s_runner.end_effector_scores(episode, robot.length)
+  scores = end_effector_episode(agent, task, seed, run.profile, show_progress)
   episode_snapshots.save_scores(path, scores, subject)
   return scores
 
