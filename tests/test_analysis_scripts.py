@@ -410,3 +410,31 @@ def test_stream_actions_compares_a_strategys_modules_with_the_reference(
   reference_errors = [float(row[3]) for row in rows if row[1] == "reference"]
   learned_errors = [float(row[3]) for row in rows if row[1] == "independent"]
   assert max(reference_errors) < min(learned_errors)  # It plans on the simulator itself.
+
+
+def test_rescore_on_v1_goes_on_where_its_out_file_stopped(monkeypatch, capsys, tmp_path):
+  from softbench.robots import base
+  from softbench.runners import zoo_verification
+
+  monkeypatch.setattr(base.SoftArm, "physics_sha256", base.SoftArm.physics_sha256)  # Restored.
+  rescored = []
+
+  def moved_by_half_a_millimetre(record: dict, seed: int) -> dict:  # No physics in this test.
+    rescored.append(record["task"] + "-" + record["eval_mode"])
+    (entry,) = [entry for entry in record["per_seed"] if entry["seed"] == seed]
+    return {**entry, "position_mm": {"mean": entry["position_mm"]["mean"] + 0.5}}
+
+  monkeypatch.setattr(zoo_verification, "rescored", moved_by_half_a_millimetre)
+  out = tmp_path / "rows.md"
+  arguments = ["--agents", "smpl", "--profile", "default", "--seeds", "1", "--out", str(out)]
+  printed = run_script("rescore_on_v1", arguments, monkeypatch, capsys)
+  rows = [line for line in out.read_text().splitlines() if line.startswith("| smpl-")]
+  assert len(rows) == len(rescored) >= 2 and printed.splitlines()[2:] == rows
+  assert all(" | 1 | " in line and line.endswith(" | 5.00e-01 |") for line in rows)
+
+  kept = rows[:-2]  # As if stopped before its last two records.
+  out.write_text("".join(line + "\n" for line in out.read_text().splitlines()[:2] + kept))
+  rescored.clear()
+  run_script("rescore_on_v1", arguments, monkeypatch, capsys)
+  assert len(rescored) == 2
+  assert [line for line in out.read_text().splitlines() if line.startswith("| smpl-")] == rows

@@ -9,17 +9,23 @@ the errors are simulated on v1. Prints one markdown row per record: the module-a
 error (mm) of the v0 record and of the v1 re-score (mean ± std over the seeds re-scored), and the
 largest difference of a seed.
 
+With ``--out FILE`` each row is also added to FILE (rewritten atomically) as soon as it is made,
+and the records FILE already has a row of are skipped: an interrupted run, given the same FILE,
+goes on with the records still to re-score (a paper-profile pass takes core-hours).
+
 Usage (on the current stack, physics v1):
   python docs/analysis/rescore_on_v1.py [--agents smpl ...] [--profile default] [--seeds N]
-      [--results leaderboard/results] [--zoo zoo]
+      [--results leaderboard/results] [--zoo zoo] [--out rows.md]
 """
 
 import argparse
 import pathlib
+import re
 
 import numpy as np
 
 from softbench import records
+from softbench import storage
 from softbench import zoo
 from softbench.records import fields as record_fields
 from softbench.robots import base
@@ -28,6 +34,10 @@ from softbench.runners import zoo_verification
 
 CHECKOUT = pathlib.Path(__file__).resolve().parents[2]
 METRIC = "position_mm"
+HEADER = (
+  f"| record (v0) | seeds | v0 {METRIC} | v1 re-score | largest seed difference (mm) |\n"
+  "|---|---:|---|---|---:|\n"
+)
 
 
 def v0_hashes(entries) -> dict[str, str]:
@@ -49,6 +59,9 @@ def main(argv: list[str] | None = None) -> None:
   parser.add_argument("--seeds", type=int, default=None, help="seeds 0 .. N-1 (default: all)")
   parser.add_argument("--results", type=pathlib.Path, default=CHECKOUT / "leaderboard" / "results")
   parser.add_argument("--zoo", type=pathlib.Path, default=CHECKOUT / "zoo")
+  parser.add_argument(
+    "--out", type=pathlib.Path, help="also add each row to this file; skip its rows"
+  )
   args = parser.parse_args(argv)
   if versions.current().name == versions.FIRST:
     raise SystemExit("error: run this on the current stack (physics v1), not the old one")
@@ -64,9 +77,12 @@ def main(argv: list[str] | None = None) -> None:
       continue
     if record["profile"] == args.profile and (args.seeds is None or seed < args.seeds):
       wanted.setdefault(name, []).append(seed)
-  print(f"| record (v0) | seeds | v0 {METRIC} | v1 re-score | largest seed difference (mm) |")
-  print("|---|---:|---|---|---:|")
+  table = args.out.read_text(encoding="utf-8") if args.out and args.out.exists() else HEADER
+  done = set(re.findall(r"^\| (\S+\.json) \|", table, re.MULTILINE))
+  print(HEADER, end="")
   for name in sorted(wanted):
+    if name in done:
+      continue
     record, seeds = found[name], sorted(wanted[name])
     old, new = [], []
     for seed in seeds:
@@ -76,11 +92,14 @@ def main(argv: list[str] | None = None) -> None:
       old.append(_mean(stored))
       new.append(_mean(again))
     worst = float(np.max(np.abs(np.subtract(new, old))))
-    print(
+    row = (
       f"| {name} | {len(seeds)} | {np.mean(old):.4f} ± {np.std(old):.4f} | "
-      f"{np.mean(new):.4f} ± {np.std(new):.4f} | {worst:.2e} |",
-      flush=True,
+      f"{np.mean(new):.4f} ± {np.std(new):.4f} | {worst:.2e} |\n"
     )
+    print(row, end="", flush=True)
+    if args.out:
+      table += row
+      storage.write_atomically(args.out, table)
 
 
 def _mean(entry: dict) -> float:
