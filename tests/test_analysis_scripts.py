@@ -413,10 +413,12 @@ def test_stream_actions_compares_a_strategys_modules_with_the_reference(
 
 
 def test_rescore_on_v1_goes_on_where_its_out_file_stopped(monkeypatch, capsys, tmp_path):
+  from softbench import zoo
   from softbench.robots import base
   from softbench.runners import zoo_verification
 
   monkeypatch.setattr(base.SoftArm, "physics_sha256", base.SoftArm.physics_sha256)  # Restored.
+  monkeypatch.setattr(zoo, "restore", zoo.restore)
   rescored = []
 
   def moved_by_half_a_millimetre(record: dict, seed: int) -> dict:  # No physics in this test.
@@ -438,3 +440,31 @@ def test_rescore_on_v1_goes_on_where_its_out_file_stopped(monkeypatch, capsys, t
   run_script("rescore_on_v1", arguments, monkeypatch, capsys)
   assert len(rescored) == 2
   assert [line for line in out.read_text().splitlines() if line.startswith("| smpl-")] == rows
+
+
+def _rescore_module():
+  spec = importlib.util.spec_from_file_location("rescore_on_v1", ANALYSIS / "rescore_on_v1.py")
+  module = importlib.util.module_from_spec(spec)
+  spec.loader.exec_module(module)
+  return module
+
+
+def test_rescore_on_v1_keys_robots_by_their_v0_hash_and_never_trains(tmp_path):
+  from softbench import zoo
+
+  rescore = _rescore_module()
+  entries = [
+    zoo.ZooFile("a.pt", "0", 1, "agent", "a", {"robot": "tendon-3", "robot_xml_sha256": "old"}),
+    zoo.ZooFile(
+      "b.pt", "0", 1, "agent", "b", {"robot": "tendon-3", "robot_xml_sha256": "new"}, (), "v1"
+    ),
+  ]
+  assert rescore.v0_hashes(entries) == {"tendon-3": "old"}
+  assert rescore.v0_hashes(entries[::-1]) == {"tendon-3": "old"}
+
+  present = tmp_path / "present.pt"
+  present.write_bytes(b"weights")
+  restore = rescore.refusing_to_train(lambda cache_file: [])
+  assert restore(present) == []
+  with pytest.raises(SystemExit, match="the zoo has no missing.pt; re-scoring would train it"):
+    restore(tmp_path / "missing.pt")

@@ -7,7 +7,7 @@ robots' hashes. On v1 this script keys every robot by the hash its zoo entries n
 record's seeds in an empty data home (``zoo_verification.rescored``): the targets, the episodes and
 the errors are simulated on v1. Prints one markdown row per record: the module-averaged position
 error (mm) of the v0 record and of the v1 re-score (mean ± std over the seeds re-scored), and the
-largest difference of a seed.
+largest difference of a seed. A model the zoo lacks stops the script: a re-score never trains.
 
 With ``--out FILE`` each row is also added to FILE (rewritten atomically) as soon as it is made,
 and the records FILE already has a row of are skipped: an interrupted run, given the same FILE,
@@ -19,8 +19,10 @@ Usage (on the current stack, physics v1):
 """
 
 import argparse
+from collections.abc import Callable
 import pathlib
 import re
+import tempfile
 
 import numpy as np
 
@@ -41,15 +43,30 @@ HEADER = (
 
 
 def v0_hashes(entries) -> dict[str, str]:
-  """The v0 hash of each robot, as the zoo's entries name it."""
+  """The v0 hash of each robot, as the zoo's v0 entries name it (its v1 entries name another)."""
   hashes = {}
   for entry in entries:
+    if entry.physics != versions.FIRST:
+      continue
     config = entry.config
     names, shas = config.get("robots", [config.get("robot")]), config.get("robot_xml_sha256")
     for name, sha in zip(names, shas if isinstance(shas, list) else [shas]):
       if name is not None and sha is not None:
         hashes[name] = sha
   return hashes
+
+
+def refusing_to_train(restore: Callable[[pathlib.Path], list[str]]):
+  """``zoo.restore`` that stops the script where the zoo lacks a model: re-scoring must not train
+  (a paper-profile model takes hours, and its scores would not be the record's weights')."""
+
+  def restore_or_stop(cache_file: pathlib.Path) -> list[str]:
+    taken = restore(cache_file)
+    if not cache_file.is_file():
+      raise SystemExit(f"error: the zoo has no {cache_file.name}; re-scoring would train it")
+    return taken
+
+  return restore_or_stop
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -69,6 +86,7 @@ def main(argv: list[str] | None = None) -> None:
   hashes = v0_hashes(entries)
   own_hash = base.SoftArm.physics_sha256
   base.SoftArm.physics_sha256 = lambda arm: hashes.get(arm.name) or own_hash(arm)
+  zoo.restore = refusing_to_train(zoo.restore)
   found = {path.name: record for path, record in records.read_folder(args.results)}
   wanted = {}
   for name, seed in zoo_verification.planned(args.zoo, tuple(args.agents or ()), False):
@@ -80,26 +98,28 @@ def main(argv: list[str] | None = None) -> None:
   table = args.out.read_text(encoding="utf-8") if args.out and args.out.exists() else HEADER
   done = set(re.findall(r"^\| (\S+\.json) \|", table, re.MULTILINE))
   print(HEADER, end="")
-  for name in sorted(wanted):
-    if name in done:
-      continue
-    record, seeds = found[name], sorted(wanted[name])
-    old, new = [], []
-    for seed in seeds:
-      stored = next(entry for entry in record["per_seed"] if entry["seed"] == seed)
-      with zoo_verification.empty_data_home():
-        again = zoo_verification.rescored(record, seed)
-      old.append(_mean(stored))
-      new.append(_mean(again))
-    worst = float(np.max(np.abs(np.subtract(new, old))))
-    row = (
-      f"| {name} | {len(seeds)} | {np.mean(old):.4f} ± {np.std(old):.4f} | "
-      f"{np.mean(new):.4f} ± {np.std(new):.4f} | {worst:.2e} |\n"
-    )
-    print(row, end="", flush=True)
-    if args.out:
-      table += row
-      storage.write_atomically(args.out, table)
+  with tempfile.TemporaryDirectory(prefix="softbench-rescore-references-") as shared:
+    references = pathlib.Path(shared)  # Targets simulated once, from the physics alone.
+    for name in sorted(wanted):
+      if name in done:
+        continue
+      record, seeds = found[name], sorted(wanted[name])
+      old, new = [], []
+      for seed in seeds:
+        stored = next(entry for entry in record["per_seed"] if entry["seed"] == seed)
+        with zoo_verification.empty_data_home(references):
+          again = zoo_verification.rescored(record, seed)
+        old.append(_mean(stored))
+        new.append(_mean(again))
+      worst = float(np.max(np.abs(np.subtract(new, old))))
+      row = (
+        f"| {name} | {len(seeds)} | {np.mean(old):.4f} ± {np.std(old):.4f} | "
+        f"{np.mean(new):.4f} ± {np.std(new):.4f} | {worst:.2e} |\n"
+      )
+      print(row, end="", flush=True)
+      if args.out:
+        table += row
+        storage.write_atomically(args.out, table)
 
 
 def _mean(entry: dict) -> float:
