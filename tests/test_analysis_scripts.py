@@ -35,11 +35,17 @@ def data_home(tmp_path, babbled_home):
     babbled_home(tmp_path, robot)
 
 
-def run_script(name: str, arguments: list[str], monkeypatch, capsys) -> str:
-  """Runs docs/analysis/NAME.py's main() with these arguments; returns what it printed."""
+def load_script(name: str):
+  """docs/analysis/NAME.py as a module."""
   spec = importlib.util.spec_from_file_location(name, ANALYSIS / f"{name}.py")
   module = importlib.util.module_from_spec(spec)
   spec.loader.exec_module(module)
+  return module
+
+
+def run_script(name: str, arguments: list[str], monkeypatch, capsys) -> str:
+  """Runs docs/analysis/NAME.py's main() with these arguments; returns what it printed."""
+  module = load_script(name)
   monkeypatch.setattr(sys, "argv", [name, *arguments])
   module.main()
   return capsys.readouterr().out
@@ -323,9 +329,7 @@ def test_sweep_vs_loop_times_a_part_both_ways_to_the_same_records_and_resumes(
 
 
 def test_sweep_vs_loop_counts_an_interrupted_stretch_and_passes_the_interruption_on(tmp_path):
-  spec = importlib.util.spec_from_file_location("timing", ANALYSIS / "sweep_vs_loop.py")
-  timing = importlib.util.module_from_spec(spec)
-  spec.loader.exec_module(timing)
+  timing = load_script("sweep_vs_loop")
   saved = tmp_path / "saved"  # The command's "resumable state", written when Ctrl-C reaches it.
   command = [
     sys.executable,
@@ -442,17 +446,10 @@ def test_rescore_on_v1_goes_on_where_its_out_file_stopped(monkeypatch, capsys, t
   assert [line for line in out.read_text().splitlines() if line.startswith("| smpl-")] == rows
 
 
-def _rescore_module():
-  spec = importlib.util.spec_from_file_location("rescore_on_v1", ANALYSIS / "rescore_on_v1.py")
-  module = importlib.util.module_from_spec(spec)
-  spec.loader.exec_module(module)
-  return module
-
-
 def test_rescore_on_v1_keys_robots_by_their_v0_hash_and_never_trains(tmp_path):
   from softbench import zoo
 
-  rescore = _rescore_module()
+  rescore = load_script("rescore_on_v1")
   entries = [
     zoo.ZooFile("a.pt", "0", 1, "agent", "a", {"robot": "tendon-3", "robot_xml_sha256": "old"}),
     zoo.ZooFile(
