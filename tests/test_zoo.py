@@ -536,6 +536,12 @@ def test_exp1s_networks_come_from_the_zoo(two_stages, tmp_path, monkeypatch, cap
     assert cli.main([*argv, "--results", str(tmp_path / "rescored")]) == 0
   ((_, rescored),) = records.read_folder(tmp_path / "rescored")
   assert rescored["per_seed"] == trained["per_seed"] and rescored["zoo"]["files"]
+  # `zoo verify` re-scores the Exp1S record too (its kept episodes inside the empty data home).
+  verify = ["zoo", "verify", "--results", str(tmp_path / "results"), "--zoo", str(tmp_path / "zoo")]
+  with monkeypatch.context() as patched:
+    no_training(patched)
+    assert cli.main(verify) == 0
+  assert f"{path.name} seed 0: identical" in capsys.readouterr().out
 
 
 def test_the_repositorys_zoo_is_intact_within_its_budget_and_links_committed_records():

@@ -111,7 +111,10 @@ def rescored(record: dict, seed: int) -> dict:
       for name in robots.TENDON_FAMILY_NAMES
       if exp1s_training.protocol(name).robot_names == tuple(record["robots"])
     )
-    with tempfile.TemporaryDirectory() as kept:
+    # Kept episodes name their place in the data home (``episodes.snapshots``): keep them there.
+    home = storage.softbench_home()
+    home.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix="rescored-episodes-", dir=home) as kept:
       entry = continual.score_seed(seed, profile, False, pathlib.Path(kept), family)
   else:
     module = record["scored_modules"][0] if record["task"] == "reach" else None
